@@ -1,0 +1,76 @@
+#include "hybrid_vo/geometry/cheirality.h"
+
+#include <Eigen/Geometry>
+
+namespace hybrid_vo {
+namespace {
+
+// Each witness votes +1 (t as given), -1 (t flipped), 0 (no information) or reports a conflict.
+constexpr int kConflict = 2;
+// Relative size under which a depth is considered infinite (no parallax): the sign is noise.
+constexpr double kNoParallax = 1e-12;
+
+int combine(int sign, int vote) {
+  if (vote == 0 || sign == kConflict) return sign;
+  if (vote == kConflict) return kConflict;
+  if (sign == 0) return vote;
+  return sign == vote ? sign : kConflict;
+}
+
+int vote_of_point(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Eigen::Vector2d& x1,
+                  const Eigen::Vector2d& x2) {
+  const Eigen::Vector3d r = R * homogeneous(x1), q = homogeneous(x2);
+  const Eigen::Vector3d n = r.cross(q);
+  // lambda1 * r + t = lambda2 * q, so lambda1 ~ (q x t).n and lambda2 ~ (r x t).n, both / |n|^2.
+  const double d1 = q.cross(t).dot(n), d2 = r.cross(t).dot(n);
+  const double scale = n.squaredNorm() * t.norm() * q.norm() * r.norm();
+  if (!(scale > 0.0)) return 0;
+  if (std::abs(d1) < kNoParallax * scale || std::abs(d2) < kNoParallax * scale) return 0;
+  if ((d1 > 0.0) != (d2 > 0.0)) return kConflict;
+  return d1 > 0.0 ? 1 : -1;
+}
+
+// Depth of image point a (camera `from`) on the plane back-projected from line l of the other
+// camera, as sign(numerator * denominator); the plane contains the baseline when num ~ 0.
+int vote_of_endpoint(double num, double num_scale, double den, double den_scale) {
+  if (!(std::abs(num) > kNoParallax * num_scale) || !(std::abs(den) > kNoParallax * den_scale))
+    return 0;
+  return (num > 0.0) == (den > 0.0) ? 1 : -1;
+}
+
+int vote_of_segment(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const LineSegment& s1,
+                    const LineSegment& s2) {
+  const Eigen::Vector3d l1 = s1.line(), l2 = s2.line();
+  const double n1 = l1.norm(), n2 = l2.norm(), nt = t.norm();
+  if (!(n1 > 0.0 && n2 > 0.0 && nt > 0.0)) return 0;
+  int sign = 0;
+  // Camera 1 endpoint a: depth = -(l2.t) / (l2.R a).
+  const double l2t = l2.dot(t);
+  for (const Eigen::Vector2d* a : {&s1.p1, &s1.p2}) {
+    const Eigen::Vector3d ra = R * homogeneous(*a);
+    sign = combine(sign, vote_of_endpoint(-l2t, n2 * nt, l2.dot(ra), n2 * ra.norm()));
+  }
+  // Camera 2 endpoint b: depth = (l1.R^T t) / (l1.R^T b).
+  const Eigen::Vector3d Rl1 = R * l1;
+  const double l1t = Rl1.dot(t);
+  for (const Eigen::Vector2d* b : {&s2.p1, &s2.p2}) {
+    const Eigen::Vector3d hb = homogeneous(*b);
+    sign = combine(sign, vote_of_endpoint(l1t, n1 * nt, Rl1.dot(hb), n1 * hb.norm()));
+  }
+  return sign;
+}
+
+}  // namespace
+
+bool orient_translation(const Eigen::Matrix3d& R, Eigen::Vector3d* t, const MatchView& matches) {
+  int sign = 0;
+  for (int i = 0; i < matches.num_points && sign != kConflict; ++i)
+    sign = combine(sign, vote_of_point(R, *t, matches.x1[i], matches.x2[i]));
+  for (int i = 0; i < matches.num_segments && sign != kConflict; ++i)
+    sign = combine(sign, vote_of_segment(R, *t, matches.s1[i], matches.s2[i]));
+  if (sign == kConflict) return false;
+  if (sign < 0) *t = -*t;
+  return true;
+}
+
+}  // namespace hybrid_vo

@@ -1,0 +1,276 @@
+#include "hybrid_vo/solvers/polynomial.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hybrid_vo {
+namespace {
+
+constexpr int kMax = kMaxPolynomialDegree;
+
+inline double horner(const double* c, int degree, double x) {
+  double v = c[degree];
+  for (int i = degree - 1; i >= 0; --i) v = v * x + c[i];
+  return v;
+}
+
+// Sturm chain p0 = p, p1 = p', p_k = -rem(p_{k-2}, p_{k-1}); each member scaled to a leading
+// coefficient of +-1, which keeps magnitudes sane and leaves signs (all Sturm needs) unchanged.
+class SturmChain {
+ public:
+  SturmChain(const double* monic, int degree) {
+    deg_[0] = degree;
+    std::copy(monic, monic + degree + 1, seq_[0]);
+    deg_[1] = degree - 1;
+    for (int i = 1; i <= degree; ++i) seq_[1][i - 1] = i * monic[i] / degree;
+    length_ = 2;
+    while (deg_[length_ - 1] > 0 && length_ <= kMax) {
+      const int k = length_;
+      double rem[kMax + 1];
+      const int rem_deg = remainder(seq_[k - 2], deg_[k - 2], seq_[k - 1], deg_[k - 1], rem);
+      if (rem_deg < 0) break;  // p and p' share a factor: the chain ends at their gcd.
+      const double lead = std::abs(rem[rem_deg]);
+      for (int i = 0; i <= rem_deg; ++i) seq_[k][i] = -rem[i] / lead;
+      deg_[k] = rem_deg;
+      ++length_;
+    }
+  }
+
+  int sign_changes(double x) const {
+    int changes = 0;
+    double previous = 0.0;
+    for (int k = 0; k < length_; ++k) {
+      const double* c = seq_[k];
+      double v = c[deg_[k]];
+      for (int i = deg_[k] - 1; i >= 0; --i) v = v * x + c[i];
+      if (v == 0.0) continue;
+      if (previous != 0.0 && (v > 0.0) != (previous > 0.0)) ++changes;
+      previous = v;
+    }
+    return changes;
+  }
+
+ private:
+  // Remainder of a / b; returns its degree, or -1 when it vanishes relative to a.
+  static int remainder(const double* a, int deg_a, const double* b, int deg_b, double* r) {
+    double work[kMax + 1];
+    std::copy(a, a + deg_a + 1, work);
+    double scale = 0.0;
+    for (int i = 0; i <= deg_a; ++i) scale = std::max(scale, std::abs(a[i]));
+    for (int i = deg_a; i >= deg_b; --i) {
+      const double q = work[i] / b[deg_b];
+      for (int j = 0; j <= deg_b; ++j) work[i - deg_b + j] -= q * b[j];
+    }
+    int deg_r = deg_b - 1;
+    const double tiny = 1e-13 * scale;
+    while (deg_r >= 0 && std::abs(work[deg_r]) <= tiny) --deg_r;
+    std::copy(work, work + deg_r + 1, r);
+    return deg_r;
+  }
+
+  double seq_[kMax + 1][kMax + 1];
+  int deg_[kMax + 1];
+  int length_;
+};
+
+// Value and derivative of a polynomial at x.
+void evaluate_with_derivative(const double* c, int degree, double x, double* f, double* df) {
+  double v = c[degree], d = 0.0;
+  for (int i = degree - 1; i >= 0; --i) {
+    d = d * x + v;
+    v = v * x + c[i];
+  }
+  *f = v;
+  *df = d;
+}
+
+// The single root of p in (lo, hi) where p changes sign: Newton steps, bisection when a step
+// leaves the bracket.
+double polish_bracketed_root(const double* c, int degree, double lo, double hi, double f_lo) {
+  double x = 0.5 * (lo + hi);
+  for (int iter = 0; iter < 100; ++iter) {
+    double f, df;
+    evaluate_with_derivative(c, degree, x, &f, &df);
+    if (f == 0.0) return x;
+    if ((f > 0.0) == (f_lo > 0.0)) {
+      lo = x;
+      f_lo = f;
+    } else {
+      hi = x;
+    }
+    double next = df != 0.0 ? x - f / df : lo - 1.0;
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    const double step = std::abs(next - x);
+    x = next;
+    if (step <= 4e-16 * std::abs(x) || hi - lo <= 4e-16 * std::max(std::abs(lo), std::abs(hi)))
+      break;
+  }
+  return x;
+}
+
+// Fujiwara's bound on the magnitude of the roots of a monic polynomial.
+double root_bound(const double* monic, int degree) {
+  double bound = std::abs(monic[degree - 1]);
+  for (int k = 2; k < degree; ++k)
+    bound = std::max(bound, std::pow(std::abs(monic[degree - k]), 1.0 / k));
+  bound = std::max(bound, std::pow(0.5 * std::abs(monic[0]), 1.0 / degree));
+  return 2.0 * bound * (1.0 + 1e-12) + 1e-300;
+}
+
+// Largest real root of the monic cubic x^3 + e2 x^2 + e1 x + e0.
+double largest_cubic_root(double e2, double e1, double e0) {
+  const double P = e1 - e2 * e2 / 3.0;
+  const double Q = 2.0 * e2 * e2 * e2 / 27.0 - e2 * e1 / 3.0 + e0;
+  const double D = 0.25 * Q * Q + P * P * P / 27.0;
+  double t;
+  if (D > 0.0) {
+    const double u = std::cbrt(-0.5 * Q - std::copysign(std::sqrt(D), Q));
+    t = u != 0.0 ? u - P / (3.0 * u) : 0.0;
+  } else {
+    const double rho = std::sqrt(std::max(0.0, -P / 3.0));
+    const double cos_arg = rho > 0.0 ? std::clamp(-0.5 * Q / (rho * rho * rho), -1.0, 1.0) : 0.0;
+    t = 2.0 * rho * std::cos(std::acos(cos_arg) / 3.0);
+  }
+  double x = t - e2 / 3.0;
+  for (int i = 0; i < 2; ++i) {
+    const double f = ((x + e2) * x + e1) * x + e0;
+    const double df = (3.0 * x + 2.0 * e2) * x + e1;
+    if (df == 0.0) break;
+    x -= f / df;
+  }
+  return x;
+}
+
+// Real roots of y^2 + B y + C; a slightly negative discriminant (rounding) counts as zero.
+int quadratic_roots(double B, double C, double* roots) {
+  double disc = B * B - 4.0 * C;
+  if (disc < 0.0) {
+    if (disc < -1e-12 * (B * B + 4.0 * std::abs(C))) return 0;
+    disc = 0.0;
+  }
+  const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+  if (q == 0.0) {
+    roots[0] = 0.0;  // B = C = 0
+    return 1;
+  }
+  roots[0] = q;
+  roots[1] = C / q;
+  return 2;
+}
+
+}  // namespace
+
+int real_roots_quartic(const double* c, double* roots) {
+  double scale = 0.0;
+  for (int i = 0; i <= 4; ++i) {
+    if (!std::isfinite(c[i])) return 0;
+    scale = std::max(scale, std::abs(c[i]));
+  }
+  if (!(std::abs(c[4]) > 1e-8 * scale)) return real_roots(c, 4, roots);
+  const double a = c[3] / c[4], b = c[2] / c[4], cc = c[1] / c[4], d = c[0] / c[4];
+  // x = y - a/4 gives y^4 + p y^2 + q y + r.
+  const double a2 = a * a;
+  const double p = b - 3.0 * a2 / 8.0;
+  const double q = cc - 0.5 * a * b + a2 * a / 8.0;
+  const double r = d - 0.25 * a * cc + a2 * b / 16.0 - 3.0 * a2 * a2 / 256.0;
+  // (y^2 + p/2 + m)^2 = 2m y^2 - q y + m^2 + m p + p^2/4 - r, a square when m solves the resolvent.
+  const double m = largest_cubic_root(p, 0.25 * p * p - r, -q * q / 8.0);
+  double ys[4];
+  int n = 0;
+  if (m > 1e-14 * (std::abs(p) + std::sqrt(std::abs(r)) + 1e-300)) {
+    const double s = std::sqrt(2.0 * m);
+    const double k = 0.5 * q / s;
+    n += quadratic_roots(-s, 0.5 * p + m + k, ys + n);
+    n += quadratic_roots(s, 0.5 * p + m - k, ys + n);
+  } else {
+    // q = 0: biquadratic in y^2.
+    double zs[2];
+    const int nz = quadratic_roots(p, r, zs);
+    for (int i = 0; i < nz; ++i) {
+      if (zs[i] < 0.0) continue;
+      ys[n++] = std::sqrt(zs[i]);
+      ys[n++] = -std::sqrt(zs[i]);
+    }
+  }
+  const double monic[5] = {d, cc, b, a, 1.0};
+  for (int i = 0; i < n; ++i) {
+    double x = ys[i] - 0.25 * a;
+    for (int iter = 0; iter < 3; ++iter) {
+      double f, df;
+      evaluate_with_derivative(monic, 4, x, &f, &df);
+      if (df == 0.0 || f == 0.0) break;
+      const double step = f / df;
+      x -= step;
+      if (std::abs(step) <= 1e-16 * std::abs(x)) break;
+    }
+    roots[i] = x;
+  }
+  std::sort(roots, roots + n);
+  return n;
+}
+
+double evaluate_polynomial(const double* c, int degree, double x) {
+  double v = c[degree];
+  for (int i = degree - 1; i >= 0; --i) v = v * x + c[i];
+  return v;
+}
+
+int real_roots(const double* c, int degree, double* roots) {
+  if (degree > kMax) return 0;
+  for (int i = 0; i <= degree; ++i)
+    if (!std::isfinite(c[i])) return 0;
+  while (degree > 0 && c[degree] == 0.0) --degree;
+  if (degree <= 0) return 0;
+  double monic[kMax + 1];
+  for (int i = 0; i <= degree; ++i) monic[i] = c[i] / c[degree];
+  if (degree == 1) {
+    roots[0] = -monic[0];
+    return 1;
+  }
+
+  const SturmChain chain(monic, degree);
+  const double bound = root_bound(monic, degree);
+  struct Interval {
+    double lo, hi;
+    int changes_lo, changes_hi;
+  };
+  Interval stack[4 * kMax + 8];
+  int top = 0;
+  stack[top++] = {-bound, bound, chain.sign_changes(-bound), chain.sign_changes(bound)};
+  int found = 0;
+  int budget = 2000;  // bisections; only clusters of near-multiple roots come close.
+  while (top > 0 && found < degree && budget-- > 0) {
+    const Interval iv = stack[--top];
+    const int count = iv.changes_lo - iv.changes_hi;
+    if (count <= 0) continue;
+    const double width = iv.hi - iv.lo;
+    const double mid = 0.5 * (iv.lo + iv.hi);
+    if (width <= 1e-14 * std::max(1.0, std::abs(mid))) {
+      roots[found++] = mid;  // a multiple root, or roots closer than we can separate
+      continue;
+    }
+    if (count == 1) {
+      const double f_lo = horner(monic, degree, iv.lo);
+      const double f_hi = horner(monic, degree, iv.hi);
+      if (f_lo == 0.0) {
+        roots[found++] = iv.lo;
+        continue;
+      }
+      if ((f_lo > 0.0) != (f_hi > 0.0)) {
+        roots[found++] = polish_bracketed_root(monic, degree, iv.lo, iv.hi, f_lo);
+        continue;
+      }
+      // No sign change: an even-multiplicity root; keep bisecting on the Sturm counts.
+    }
+    const int changes_mid = chain.sign_changes(mid);
+    // Upper half first so that the lower half is popped first and roots come out ascending.
+    if (changes_mid - iv.changes_hi > 0 && top < 4 * kMax + 8)
+      stack[top++] = {mid, iv.hi, changes_mid, iv.changes_hi};
+    if (iv.changes_lo - changes_mid > 0 && top < 4 * kMax + 8)
+      stack[top++] = {iv.lo, mid, iv.changes_lo, changes_mid};
+  }
+  std::sort(roots, roots + found);
+  return found;
+}
+
+}  // namespace hybrid_vo

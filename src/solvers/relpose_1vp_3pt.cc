@@ -1,0 +1,50 @@
+#include "hybrid_vo/solvers/relpose_1vp_3pt.h"
+
+#include <Eigen/Geometry>
+
+#include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/geometry/rotation.h"
+#include "hybrid_vo/solvers/upright_3pt.h"
+
+namespace hybrid_vo {
+
+int relpose_1vp_3pt(const Eigen::Vector3d& v1, const Eigen::Vector3d& v2, const Eigen::Vector2d* x1,
+                    const Eigen::Vector2d* x2, const MatchView& witnesses, bool vp_sign_known,
+                    RelativePoses* poses) {
+  poses->clear();
+  const double n1 = v1.norm(), n2 = v2.norm();
+  if (!(n1 > 0.0 && n2 > 0.0) || !all_finite(v1) || !all_finite(v2)) return 0;
+  const Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY();
+  // R = R2x^T R_y(phi) R1x, where R1x and R2x take the VPs to the y-axis (paper eq. 7).
+  const Eigen::Matrix3d R1x = rotation_between(v1 / n1, y_axis);
+  Eigen::Vector3d q1[3], q2[3];
+  for (int i = 0; i < 3; ++i) q1[i] = R1x * homogeneous(x1[i]);
+  for (const double sign : {1.0, -1.0}) {
+    if (sign < 0.0 && vp_sign_known) break;
+    const Eigen::Matrix3d R2x = rotation_between(sign * v2 / n2, y_axis);
+    for (int i = 0; i < 3; ++i) q2[i] = R2x * homogeneous(x2[i]);
+    Eigen::Matrix3d Ry[4];
+    Eigen::Vector3d ty[4];
+    const int n = upright_relpose_3pt(q1, q2, Ry, ty);
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Matrix3d R = R2x.transpose() * Ry[k] * R1x;
+      Eigen::Vector3d t = R2x.transpose() * ty[k];
+      if (!orient_translation(R, &t, witnesses)) continue;
+      poses->emplace_back(R, t);
+    }
+  }
+  return static_cast<int>(poses->size());
+}
+
+int relpose_1vp_3pt(const Eigen::Vector3d& v1, const Eigen::Vector3d& v2,
+                    const std::array<Eigen::Vector2d, 3>& x1,
+                    const std::array<Eigen::Vector2d, 3>& x2, RelativePoses* poses,
+                    bool vp_sign_known) {
+  MatchView witnesses;
+  witnesses.x1 = x1.data();
+  witnesses.x2 = x2.data();
+  witnesses.num_points = 3;
+  return relpose_1vp_3pt(v1, v2, x1.data(), x2.data(), witnesses, vp_sign_known, poses);
+}
+
+}  // namespace hybrid_vo

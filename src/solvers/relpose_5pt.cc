@@ -1,0 +1,229 @@
+#include "hybrid_vo/solvers/relpose_5pt.h"
+
+#include <cmath>
+
+#include <Eigen/LU>
+#include <Eigen/QR>
+
+#include "hybrid_vo/geometry/essential.h"
+#include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/solvers/polynomial.h"
+
+namespace hybrid_vo {
+namespace {
+
+// E = x X + y Y + z Z + W. Polynomials in (x, y, z) up to degree 3 use these monomial orders:
+//   degree 1: x y z 1
+//   degree 2: xx xy xz yy yz zz x y z 1
+//   degree 3: xxx yyy xxy xyy xxz xx yyz yy xyz xy | xzz xz x yzz yz y zzz zz z 1
+// The first ten cubic monomials are eliminated (Nistér's Sec. 3.2 ordering).
+using Linear = Eigen::Matrix<double, 4, 1>;
+using Quadratic = Eigen::Matrix<double, 10, 1>;
+using Cubic = Eigen::Matrix<double, 20, 1>;
+
+constexpr int kLinearTimesLinear[4][4] = {{0, 1, 2, 6}, {1, 3, 4, 7}, {2, 4, 5, 8}, {6, 7, 8, 9}};
+constexpr int kQuadraticTimesLinear[10][4] = {
+    {0, 2, 4, 5},     {2, 3, 8, 9},    {4, 8, 10, 11},  {3, 1, 6, 7},    {8, 6, 13, 14},
+    {10, 13, 16, 17}, {5, 9, 11, 12},  {9, 7, 14, 15},  {11, 14, 17, 18}, {12, 15, 18, 19}};
+
+Quadratic multiply(const Linear& a, const Linear& b) {
+  Quadratic r = Quadratic::Zero();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) r(kLinearTimesLinear[i][j]) += a(i) * b(j);
+  return r;
+}
+
+void multiply_add(const Quadratic& a, const Linear& b, Cubic* r) {
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 4; ++j) (*r)(kQuadraticTimesLinear[i][j]) += a(i) * b(j);
+}
+
+// Product of polynomials in z with ascending coefficients.
+template <int A, int B>
+Eigen::Matrix<double, A + B - 1, 1> poly_multiply(const Eigen::Matrix<double, A, 1>& a,
+                                                  const Eigen::Matrix<double, B, 1>& b) {
+  Eigen::Matrix<double, A + B - 1, 1> r = Eigen::Matrix<double, A + B - 1, 1>::Zero();
+  for (int i = 0; i < A; ++i)
+    for (int j = 0; j < B; ++j) r(i + j) += a(i) * b(j);
+  return r;
+}
+
+template <int N>
+double poly_eval(const Eigen::Matrix<double, N, 1>& c, double z) {
+  double v = c(N - 1);
+  for (int i = N - 2; i >= 0; --i) v = v * z + c(i);
+  return v;
+}
+
+// Row (top) - z * row (bottom) of the eliminated system is linear in x and y: its x, y and
+// constant parts as polynomials in z.
+struct ZRow {
+  Eigen::Vector4d x, y;
+  Eigen::Matrix<double, 5, 1> one;
+};
+
+ZRow z_row(const Eigen::Matrix<double, 10, 10>& B, int top, int bottom) {
+  const auto t = B.row(top), b = B.row(bottom);
+  ZRow r;
+  r.x << t(2), t(1) - b(2), t(0) - b(1), -b(0);
+  r.y << t(5), t(4) - b(5), t(3) - b(4), -b(3);
+  r.one << t(9), t(8) - b(9), t(7) - b(8), t(6) - b(7), -b(6);
+  return r;
+}
+
+// Gauss-Jordan elimination with partial pivoting of the left 10x10 block of C; B receives the
+// right block of the reduced system [I | B]. Hand-written because Eigen's blocked LU and triangular
+// solves cost more than the arithmetic at this size.
+bool eliminate_leading_monomials(Eigen::Matrix<double, 10, 20> M, Eigen::Matrix<double, 10, 10>* B) {
+  for (int k = 0; k < 10; ++k) {
+    int pivot = k;
+    for (int i = k + 1; i < 10; ++i)
+      if (std::abs(M(i, k)) > std::abs(M(pivot, k))) pivot = i;
+    if (!(std::abs(M(pivot, k)) > 0.0) || !std::isfinite(M(pivot, k))) return false;
+    if (pivot != k) M.row(pivot).swap(M.row(k));
+    const double inv = 1.0 / M(k, k);
+    for (int j = k + 1; j < 20; ++j) M(k, j) *= inv;
+    for (int i = 0; i < 10; ++i) {
+      if (i == k) continue;
+      const double f = M(i, k);
+      if (f == 0.0) continue;
+      for (int j = k + 1; j < 20; ++j) M(i, j) -= f * M(k, j);
+    }
+  }
+  *B = M.rightCols<10>();
+  return all_finite(*B);
+}
+
+// One Gauss-Newton step of (x, y, z) on the ten cubic constraints C m(x, y, z) = 0. The degree-10
+// polynomial loses digits when two of its roots are close; the original system does not.
+void refine_xyz(const Eigen::Matrix<double, 10, 20>& C, double* x, double* y, double* z) {
+  const double a = *x, b = *y, c = *z;
+  Eigen::Matrix<double, 20, 4> m;  // monomials and their x, y, z derivatives, in kCubic order
+  m.col(0) << a * a * a, b * b * b, a * a * b, a * b * b, a * a * c, a * a, b * b * c, b * b,
+      a * b * c, a * b, a * c * c, a * c, a, b * c * c, b * c, b, c * c * c, c * c, c, 1.0;
+  m.col(1) << 3 * a * a, 0, 2 * a * b, b * b, 2 * a * c, 2 * a, 0, 0, b * c, b, c * c, c, 1, 0, 0,
+      0, 0, 0, 0, 0;
+  m.col(2) << 0, 3 * b * b, a * a, 2 * a * b, 0, 0, 2 * b * c, 2 * b, a * c, a, 0, 0, 0, c * c, c,
+      1, 0, 0, 0, 0;
+  m.col(3) << 0, 0, 0, 0, a * a, 0, b * b, 0, a * b, 0, 2 * a * c, a, 0, 2 * b * c, b, 0,
+      3 * c * c, 2 * c, 1, 0;
+  const Eigen::Matrix<double, 10, 4> rJ = C.lazyProduct(m);  // no GEMM machinery at this size
+  const Eigen::Matrix<double, 10, 3> J = rJ.rightCols<3>();
+  const Eigen::Matrix3d JtJ = J.transpose().lazyProduct(J);
+  const Eigen::Vector3d step = -(JtJ.inverse() * (J.transpose() * rJ.col(0)));
+  if (!all_finite(step)) return;
+  *x += step(0);
+  *y += step(1);
+  *z += step(2);
+}
+
+}  // namespace
+
+int essential_5pt(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2, Eigen::Matrix3d* essentials) {
+  Eigen::Matrix<double, 9, 5> At;  // epipolar constraints as columns
+  for (int i = 0; i < 5; ++i) {
+    const Eigen::Vector3d p = homogeneous(x1[i]), q = homogeneous(x2[i]);
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) At(3 * j + k, i) = q(j) * p(k);
+  }
+  if (!all_finite(At)) return 0;
+  const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 5>> qr(At);
+  const auto& R = qr.matrixQR();
+  double largest = 0.0, smallest = INFINITY;
+  for (int i = 0; i < 5; ++i) {
+    largest = std::max(largest, std::abs(R(i, i)));
+    smallest = std::min(smallest, std::abs(R(i, i)));
+  }
+  if (!(smallest > 1e-10 * largest)) return 0;  // repeated or otherwise dependent constraints
+  // Columns X, Y, Z, W: the last four columns of Q, without forming Q.
+  Eigen::Matrix<double, 9, 4> basis = Eigen::Matrix<double, 9, 4>::Zero();
+  basis.bottomRows<4>().setIdentity();
+  basis.applyOnTheLeft(qr.householderQ());
+
+  Linear e[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) e[i][j] = basis.row(3 * i + j).transpose();
+
+  // Ten cubic constraints: det(E) = 0 and (2 E E^T - tr(E E^T) I) E = 0.
+  Quadratic EEt[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) {
+      EEt[i][j] = multiply(e[i][0], e[j][0]) + multiply(e[i][1], e[j][1]) +
+                  multiply(e[i][2], e[j][2]);
+      EEt[j][i] = EEt[i][j];
+    }
+  const Quadratic trace = EEt[0][0] + EEt[1][1] + EEt[2][2];
+  Eigen::Matrix<double, 10, 20> C = Eigen::Matrix<double, 10, 20>::Zero();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      Cubic row = Cubic::Zero();
+      for (int k = 0; k < 3; ++k) {
+        Quadratic m = 2.0 * EEt[i][k];
+        if (i == k) m -= trace;
+        multiply_add(m, e[k][j], &row);
+      }
+      C.row(3 * i + j) = row.transpose();
+    }
+  Cubic det = Cubic::Zero();
+  multiply_add(multiply(e[1][1], e[2][2]) - multiply(e[1][2], e[2][1]), e[0][0], &det);
+  multiply_add(multiply(e[1][2], e[2][0]) - multiply(e[1][0], e[2][2]), e[0][1], &det);
+  multiply_add(multiply(e[1][0], e[2][1]) - multiply(e[1][1], e[2][0]), e[0][2], &det);
+  C.row(9) = det.transpose();
+
+  // Gauss-Jordan on the first ten monomials: monomial_i + B.row(i) . rest = 0.
+  Eigen::Matrix<double, 10, 10> B;
+  if (!eliminate_leading_monomials(C, &B)) return 0;
+
+  const ZRow k = z_row(B, 4, 5), l = z_row(B, 6, 7), m = z_row(B, 8, 9);
+  // (x, y, 1) is orthogonal to all three rows, so det = 0 and (x, y, 1) ~ k x l.
+  const Eigen::Matrix<double, 8, 1> p1 = poly_multiply(k.y, l.one) - poly_multiply(k.one, l.y);
+  const Eigen::Matrix<double, 8, 1> p2 = poly_multiply(k.one, l.x) - poly_multiply(k.x, l.one);
+  const Eigen::Matrix<double, 7, 1> p3 = poly_multiply(k.x, l.y) - poly_multiply(k.y, l.x);
+  Eigen::Matrix<double, 11, 1> det_z = poly_multiply(m.x, p1) + poly_multiply(m.y, p2);
+  det_z += poly_multiply(m.one, p3);
+
+  double roots[10];
+  const int num_roots = real_roots(det_z.data(), 10, roots);
+  int count = 0;
+  for (int r = 0; r < num_roots; ++r) {
+    const double z = roots[r];
+    // Null vector of the 3x3 system at z from its best-conditioned pair of rows.
+    Eigen::Matrix3d Bz;
+    Bz << poly_eval(k.x, z), poly_eval(k.y, z), poly_eval(k.one, z), poly_eval(l.x, z),
+        poly_eval(l.y, z), poly_eval(l.one, z), poly_eval(m.x, z), poly_eval(m.y, z),
+        poly_eval(m.one, z);
+    Eigen::Vector3d xy1 = Bz.row(0).cross(Bz.row(1));
+    const Eigen::Vector3d c02 = Bz.row(0).cross(Bz.row(2)), c12 = Bz.row(1).cross(Bz.row(2));
+    if (std::abs(c02(2)) > std::abs(xy1(2))) xy1 = c02;
+    if (std::abs(c12(2)) > std::abs(xy1(2))) xy1 = c12;
+    if (!(std::abs(xy1(2)) > 0.0)) continue;
+    double x = xy1(0) / xy1(2), y = xy1(1) / xy1(2), z_refined = z;
+    refine_xyz(C, &x, &y, &z_refined);
+    const Eigen::Matrix<double, 9, 1> e_vec = x * basis.col(0) + y * basis.col(1) +
+                                              z_refined * basis.col(2) + basis.col(3);
+    if (!all_finite(e_vec)) continue;
+    Eigen::Matrix3d& E = essentials[count++];
+    E << e_vec(0), e_vec(1), e_vec(2), e_vec(3), e_vec(4), e_vec(5), e_vec(6), e_vec(7), e_vec(8);
+  }
+  return count;
+}
+
+int relpose_5pt(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2, const MatchView& witnesses,
+                RelativePoses* poses) {
+  poses->clear();
+  Eigen::Matrix3d essentials[10];
+  const int n = essential_5pt(x1, x2, essentials);
+  for (int i = 0; i < n; ++i) poses_from_essential(essentials[i], witnesses, poses);
+  return static_cast<int>(poses->size());
+}
+
+int relpose_5pt(const std::array<Eigen::Vector2d, 5>& x1, const std::array<Eigen::Vector2d, 5>& x2,
+                RelativePoses* poses) {
+  MatchView witnesses;
+  witnesses.x1 = x1.data();
+  witnesses.x2 = x2.data();
+  witnesses.num_points = 5;
+  return relpose_5pt(x1.data(), x2.data(), witnesses, poses);
+}
+
+}  // namespace hybrid_vo
