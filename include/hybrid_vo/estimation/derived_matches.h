@@ -1,0 +1,40 @@
+#pragma once
+
+#include <vector>
+
+#include "hybrid_vo/estimation/matches.h"
+
+namespace hybrid_vo {
+
+// Where a point-like match comes from, so that ablations can switch each source off.
+enum class PointSource { kPoint, kJunction, kEndpoint };
+
+struct DerivedPoint {
+  PointMatch match;  // pixels
+  PointSource source = PointSource::kPoint;
+  int first = -1;    // point index, or the (first) line index
+  int second = -1;   // junction: the second line; endpoint: 0 or 1 (which end of `first`)
+};
+
+struct JunctionOptions {
+  // How far beyond a segment's end its intersection with the other segment may lie, in pixels.
+  double tolerance_px = 3.0;
+  // Junctions of nearly parallel segments are badly localised along the lines.
+  double min_angle_deg = 15.0;
+};
+
+// Junctions of segment matches (paper supp. Sec. B): pairs whose intersection lies on both
+// segments, up to the tolerance, in both images. Invalid (zero-length, non-finite) segments never
+// form junctions. O(n^2) in the number of segments.
+std::vector<DerivedPoint> find_junctions(const std::vector<LineMatch>& lines,
+                                         const JunctionOptions& options = {});
+
+// Segment endpoints as point matches. Endpoints of matched segments correspond only when the
+// detector cut both segments at the same 3D points, so they are a weaker source than junctions;
+// the ends are paired so that the segments point the same way in both images.
+std::vector<DerivedPoint> segment_endpoints(const std::vector<LineMatch>& lines);
+
+// A segment with finite endpoints at least `min_length` pixels apart.
+bool valid_segment(const LineSegment& s, double min_length = 1e-6);
+
+}  // namespace hybrid_vo

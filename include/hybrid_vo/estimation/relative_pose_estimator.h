@@ -1,0 +1,119 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "hybrid_vo/estimation/derived_matches.h"
+#include "hybrid_vo/estimation/final_refinement.h"
+#include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/geometry/camera.h"
+#include "hybrid_vo/geometry/pose.h"
+#include "hybrid_vo/solvers/minimal_solver.h"
+
+namespace hybrid_vo {
+
+// Hybrid RANSAC over the minimal solvers (paper Sec. 4, after Camposeco et al. 2018).
+struct HybridRansacOptions {
+  // Which solvers may be drawn, and their prior weights. 2-2-0 is degenerate and stays off.
+  std::array<bool, kNumSolvers> enabled;
+  std::array<double, kNumSolvers> prior;
+  // Inlier thresholds: Sampson error of point-like matches in pixels, angle of VP matches.
+  double point_threshold_px = 1.0;
+  double vp_threshold_deg = 2.0;
+  // One VP match scores like this many point matches (it summarises a whole line cluster).
+  double vp_score_weight = 10.0;
+  // A line match alone cannot be verified by a relative pose, so solver selection uses a preset
+  // line inlier ratio (paper Sec. 4). Termination uses the measured support instead (lines with
+  // an inlier junction or agreeing with an inlier VP), a lower bound. Points and VPs start from
+  // the initial ratios until a model measures them.
+  double line_inlier_ratio = 0.6;
+  double initial_point_inlier_ratio = 0.5;
+  double initial_vp_inlier_ratio = 0.8;
+  // Share of draws spread uniformly over the available solvers, the rest following the adaptive
+  // probabilities: keeps every solver in play when the current best model is wrong.
+  double exploration = 0.2;
+  // Stop once every solver's draws together have missed an all-inlier sample with probability
+  // below 1 - confidence, but not before min_iterations.
+  double confidence = 0.999;
+  int min_iterations = 50;
+  int max_iterations = 5000;
+  // Local optimisation (Levenberg-Marquardt on a subset of the inliers) of every new best model.
+  bool local_optimization = true;
+  int lo_max_points = 256;
+  int lo_rounds = 4;  // refine, re-select inliers, refine again while the cost drops
+  // VPs whose directions are within this angle of orthogonal count as orthogonal (Manhattan),
+  // so that lines of one serve as the orthogonal line of the other (2-1-1, 1-2-1, 2-0-1).
+  double orthogonal_tolerance_deg = 10.0;
+  uint64_t seed = 0;
+
+  HybridRansacOptions();
+};
+
+struct RelativePoseEstimatorOptions {
+  HybridRansacOptions ransac;
+  // Point-like data besides the point matches; line solvers use junctions either way.
+  bool use_junction_points = false;
+  bool use_endpoint_points = false;
+  JunctionOptions junctions;
+  bool final_refinement = true;
+  FinalRefinementOptions refinement;
+  // Below this many point-like inliers (and no inlier VP pair to fix the rotation), the best model
+  // is not trusted and the status is kNoModel.
+  int min_point_inliers = 5;
+};
+
+// The paper's table rows: "5pc", "5pc+junc", "5pc+4pc", "5pc+4pc+junc", "hybrid", "hybrid+junc".
+bool preset_options(const std::string& preset, RelativePoseEstimatorOptions* options);
+const std::vector<std::string>& preset_names();
+
+enum class EstimationStatus {
+  kOk,
+  kInvalidInput,    // a camera is not invertible
+  kTooLittleData,   // no enabled solver can draw a sample from the valid data
+  kDegenerate,      // samples were drawn but no solver produced a pose
+  kNoModel,         // poses were produced but none has enough support
+};
+const char* to_string(EstimationStatus status);
+
+struct SolverStatistics {
+  int sampled = 0;   // iterations that drew this solver
+  int models = 0;    // poses it produced and that were scored
+  int best = 0;      // times one of its poses became the best model
+};
+
+struct RelativePoseEstimate {
+  EstimationStatus status = EstimationStatus::kTooLittleData;
+  RelativePose pose;  // unit t; identity/zero unless status == kOk
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool covariance_valid = false;
+
+  // Inlier masks per data type, aligned with the inputs and the derived lists below.
+  std::vector<char> point_inliers, line_inliers, vp_inliers;
+  std::vector<DerivedPoint> junctions, endpoints;
+  std::vector<char> junction_inliers, endpoint_inliers;
+  int num_point_inliers = 0, num_line_inliers = 0, num_vp_inliers = 0;
+  int num_junction_inliers = 0, num_endpoint_inliers = 0;
+
+  std::array<SolverStatistics, kNumSolvers> solvers{};
+  SolverId best_solver = SolverId::k5pt;
+  int iterations = 0;
+  int local_optimizations = 0;
+  // Invalid inputs (non-finite, zero-length, bad VP labels) skipped before estimation.
+  int rejected_points = 0, rejected_lines = 0, rejected_vps = 0;
+  double derive_ms = 0.0, ransac_ms = 0.0, refine_ms = 0.0, total_ms = 0.0;
+  bool refined = false;
+};
+
+// Relative pose between two calibrated views from points, segments and VPs (paper Sec. 4).
+// Everything is in pixels with each camera's intrinsics; the pose maps camera-1 coordinates to
+// camera-2 coordinates with a unit translation.
+RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
+                                            const PinholeCamera& camera2,
+                                            const TwoViewMatches& matches,
+                                            const RelativePoseEstimatorOptions& options = {});
+
+}  // namespace hybrid_vo

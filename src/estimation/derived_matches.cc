@@ -1,0 +1,90 @@
+#include "hybrid_vo/estimation/derived_matches.h"
+
+#include <cmath>
+
+namespace hybrid_vo {
+namespace {
+
+struct SegmentGeometry {
+  Eigen::Vector2d origin, direction;  // unit direction
+  double length = 0.0;
+};
+
+SegmentGeometry geometry_of(const LineSegment& s) {
+  SegmentGeometry g;
+  g.origin = s.p1;
+  g.length = s.length();
+  g.direction = (s.p2 - s.p1) / g.length;
+  return g;
+}
+
+// Intersection of two segments' lines when it lies on both (within `tolerance` pixels past an
+// end) and they cross at an angle whose sine is at least `min_sin`.
+bool intersect_segments(const SegmentGeometry& a, const SegmentGeometry& b, double tolerance,
+                        double min_sin, Eigen::Vector2d* x) {
+  const double cross = a.direction.x() * b.direction.y() - a.direction.y() * b.direction.x();
+  if (std::abs(cross) < min_sin) return false;
+  const Eigen::Vector2d d = b.origin - a.origin;
+  const double ta = (d.x() * b.direction.y() - d.y() * b.direction.x()) / cross;
+  const double tb = (d.x() * a.direction.y() - d.y() * a.direction.x()) / cross;
+  if (ta < -tolerance || ta > a.length + tolerance) return false;
+  if (tb < -tolerance || tb > b.length + tolerance) return false;
+  *x = a.origin + ta * a.direction;
+  return true;
+}
+
+}  // namespace
+
+bool valid_segment(const LineSegment& s, double min_length) {
+  return all_finite(s.p1) && all_finite(s.p2) && s.length() > min_length;
+}
+
+std::vector<DerivedPoint> find_junctions(const std::vector<LineMatch>& lines,
+                                         const JunctionOptions& options) {
+  const int n = static_cast<int>(lines.size());
+  std::vector<char> valid(n);
+  std::vector<SegmentGeometry> g1(n), g2(n);
+  for (int i = 0; i < n; ++i) {
+    valid[i] = valid_segment(lines[i].s1) && valid_segment(lines[i].s2);
+    if (!valid[i]) continue;
+    g1[i] = geometry_of(lines[i].s1);
+    g2[i] = geometry_of(lines[i].s2);
+  }
+  const double min_sin = std::sin(options.min_angle_deg * M_PI / 180.0);
+  std::vector<DerivedPoint> junctions;
+  for (int i = 0; i < n; ++i) {
+    if (!valid[i]) continue;
+    for (int j = i + 1; j < n; ++j) {
+      if (!valid[j]) continue;
+      DerivedPoint jp;
+      if (!intersect_segments(g1[i], g1[j], options.tolerance_px, min_sin, &jp.match.x1)) continue;
+      if (!intersect_segments(g2[i], g2[j], options.tolerance_px, min_sin, &jp.match.x2)) continue;
+      jp.source = PointSource::kJunction;
+      jp.first = i;
+      jp.second = j;
+      junctions.push_back(jp);
+    }
+  }
+  return junctions;
+}
+
+std::vector<DerivedPoint> segment_endpoints(const std::vector<LineMatch>& lines) {
+  std::vector<DerivedPoint> endpoints;
+  for (int i = 0; i < static_cast<int>(lines.size()); ++i) {
+    const LineSegment &a = lines[i].s1, &b = lines[i].s2;
+    if (!valid_segment(a) || !valid_segment(b)) continue;
+    const bool same_way = (a.p2 - a.p1).dot(b.p2 - b.p1) >= 0.0;
+    for (int end = 0; end < 2; ++end) {
+      DerivedPoint p;
+      p.source = PointSource::kEndpoint;
+      p.first = i;
+      p.second = end;
+      p.match.x1 = end == 0 ? a.p1 : a.p2;
+      p.match.x2 = (end == 0) == same_way ? b.p1 : b.p2;
+      endpoints.push_back(p);
+    }
+  }
+  return endpoints;
+}
+
+}  // namespace hybrid_vo

@@ -1,0 +1,431 @@
+#include "hybrid_vo/estimation/final_refinement.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <ceres/ceres.h>
+
+#include "hybrid_vo/geometry/homogeneous.h"
+
+namespace hybrid_vo {
+namespace {
+
+using Matrix43 = Eigen::Matrix<double, 4, 3>;
+using RowVector4d = Eigen::Matrix<double, 1, 4>;
+
+constexpr double kDegree = M_PI / 180.0;
+
+Eigen::Matrix3d rotation_of(const double* q) {
+  return Eigen::Map<const Eigen::Quaterniond>(q).normalized().toRotationMatrix();
+}
+
+// Ceres' EigenQuaternionManifold (memory x, y, z, w) has Plus(q, d) = [cos|d|, sin|d| d / |d|] q,
+// a left rotation by 2|d|, so the left increment R <- exp([w]x) R has w = 2 d. Its Jacobian at
+// d = 0 is P = [s I - [v]x; -v^T] for q = (v, s), with orthonormal columns orthogonal to q: the
+// ambient Jacobian J_q = 2 J_w P^T (nothing along q) gives J_q P = dr/dd exactly.
+Matrix43 quaternion_plus_jacobian(const double* q) {
+  const Eigen::Vector3d v(q[0], q[1], q[2]);
+  Matrix43 P;
+  P.topRows<3>() = q[3] * Eigen::Matrix3d::Identity() - skew(v);
+  P.row(3) = -v.transpose();
+  return P;
+}
+
+// Sampson error in pixels (paper Sec. 4, "reprojection error on the point correspondences"):
+// with F = K2^-T E K1^-1 and x1, x2 in pixels, r = x2^T F x1 / |grad|, where the gradient of
+// x2^T F x1 with respect to the four pixel coordinates is (Ep / f2, E^T q / f1) per axis for the
+// normalised p = K1^-1 x1, q = K2^-1 x2. Analytic Jacobian: this is the bulk of the residuals.
+class PointSampsonCost final : public ceres::SizedCostFunction<1, 4, 3> {
+ public:
+  PointSampsonCost(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector2d& w1,
+                   const Eigen::Vector2d& w2)
+      : p_(p), q_(q), w1_(w1), w2_(w2) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Matrix3d R = rotation_of(parameters[0]);
+    const Eigen::Map<const Eigen::Vector3d> t(parameters[1]);
+    // E p = t x R p and E^T q = R^T (q x t) for E = [t]x R.
+    const Eigen::Vector3d Rp = R * p_, q_x_t = q_.cross(t);
+    const Eigen::Vector3d a = t.cross(Rp), b = R.transpose() * q_x_t;
+    const Eigen::Vector3d wa(w2_.x() * a.x(), w2_.y() * a.y(), 0.0);
+    const Eigen::Vector3d wb(w1_.x() * b.x(), w1_.y() * b.y(), 0.0);
+    const double C = q_.dot(a);
+    const double D = wa.dot(a) + wb.dot(b);
+    if (!(D > 0.0) || !std::isfinite(D) || !std::isfinite(C)) {
+      // Both epipolar lines degenerate at this match: it carries no information here.
+      residuals[0] = 0.0;
+      if (jacobians && jacobians[0]) Eigen::Map<RowVector4d>(jacobians[0]).setZero();
+      if (jacobians && jacobians[1]) Eigen::Map<Eigen::RowVector3d>(jacobians[1]).setZero();
+      return true;
+    }
+    const double sqrt_D = std::sqrt(D);
+    residuals[0] = C / sqrt_D;
+    if (!jacobians) return true;
+    // dr/dE = G = (dC/dE - C / (2 D) dD/dE) / sqrt(D) with dC/dE = q p^T and
+    // dD/dE = 2 (W2 a p^T + q (W1 b)^T), i.e. G = u p^T + q v^T.
+    const double k = C / D;
+    const Eigen::Vector3d u = (q_ - k * wa) / sqrt_D, v = (-k / sqrt_D) * wb;
+    // <G, [e]x R> = e . vee(G R^T) with vee(M) = (M21 - M12, M02 - M20, M10 - M01) and
+    // vee(a b^T) = b x a. With G R^T = u (R p)^T + q (R v)^T: dE = [dt]x R gives dr/dt, and
+    // dE = [t]x [dw]x R gives dr/dw = vee(-[t]x G R^T).
+    const Eigen::Vector3d Rv = R * v;
+    if (jacobians[0]) {
+      const Eigen::Vector3d dr_dw = Rp.cross(u.cross(t)) + Rv.cross(q_x_t);
+      Eigen::Map<RowVector4d> J_q(jacobians[0]);
+      J_q = 2.0 * dr_dw.transpose() * quaternion_plus_jacobian(parameters[0]).transpose();
+    }
+    if (jacobians[1]) {
+      Eigen::Map<Eigen::RowVector3d> J_t(jacobians[1]);
+      J_t = (Rp.cross(u) + Rv.cross(q_)).transpose();
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d p_, q_;    // K1^-1 x1, K2^-1 x2
+  Eigen::Vector2d w1_, w2_;  // (1 / fx^2, 1 / fy^2) of each camera
+};
+
+// VP error given the rotation (paper Sec. 4): s (R d1 - d2) when the sign is known, else
+// s (d2 x R d1), sign-invariant; for unit d1, d2 both are the angle to first order, times s.
+class VpAngleCost final : public ceres::SizedCostFunction<3, 4> {
+ public:
+  VpAngleCost(const Eigen::Vector3d& d1, const Eigen::Vector3d& d2, bool sign_known, double scale)
+      : d1_(d1), d2_(d2), sign_known_(sign_known), scale_(scale) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Vector3d Rd1 = rotation_of(parameters[0]) * d1_;
+    Eigen::Map<Eigen::Vector3d> r(residuals);
+    r = scale_ * (sign_known_ ? Eigen::Vector3d(Rd1 - d2_) : Eigen::Vector3d(d2_.cross(Rd1)));
+    if (!jacobians || !jacobians[0]) return true;
+    // d(R d1)/dw = -[R d1]x for the left increment.
+    const Eigen::Matrix3d dRd1 = -skew(Rd1);
+    const Eigen::Matrix3d dr_dw = scale_ * (sign_known_ ? dRd1 : Eigen::Matrix3d(skew(d2_) * dRd1));
+    Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>> J_q(jacobians[0]);
+    J_q = 2.0 * dr_dw * quaternion_plus_jacobian(parameters[0]).transpose();
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d d1_, d2_;  // unit
+  bool sign_known_;
+  double scale_;
+};
+
+// Tardif's (2009) orthogonal distance, in pixels, of a segment (l = p1 x p2, midpoint m) to the
+// VP v: the distance of an endpoint p1 to the line m x v through the midpoint and v. Since
+// p1 x m = (p1 x p2) / 2 = l / 2 it is (v . l / 2) / |v_xy - v_z m|, defined for a VP at infinity
+// too (v_z = 0) and independent of the scale and sign of v. Writes dr/dv when asked; returns
+// false when v sits at the midpoint (every line through it passes the VP: no information).
+bool tardif_distance(const Eigen::Vector3d& l, const Eigen::Vector2d& m, const Eigen::Vector3d& v,
+                     double weight, double* r, Eigen::Vector3d* dr_dv) {
+  const Eigen::Vector2d g = v.head<2>() - v.z() * m;
+  const double g_norm = g.norm();
+  if (!(g_norm > 1e-12 * v.norm())) return false;
+  const double n = 0.5 * v.dot(l);
+  *r = weight * n / g_norm;
+  if (dr_dv) {
+    // dr/dv = w (l / 2 / |g| - n A^T g / |g|^3), A = [I2, -m].
+    const Eigen::Vector3d A_t_g(g.x(), g.y(), -m.dot(g));
+    *dr_dv = weight * (0.5 * l / g_norm - n / (g_norm * g_norm * g_norm) * A_t_g);
+  }
+  return true;
+}
+
+// Line-to-VP consistency with the VP direction fixed: a segment against the VP predicted from
+// the other image, v = K R d1 (segment in image 2) or v = K R^T d2 (segment in image 1).
+class LineVpCost final : public ceres::SizedCostFunction<1, 4> {
+ public:
+  LineVpCost(const Eigen::Matrix3d& K, const LineSegment& segment, const Eigen::Vector3d& direction,
+             bool inverse_rotation, double weight)
+      : K_(K),
+        l_(homogeneous(segment.p1).cross(homogeneous(segment.p2))),
+        m_(segment.midpoint()),
+        d_(direction),
+        inverse_rotation_(inverse_rotation),
+        weight_(weight) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Matrix3d R = rotation_of(parameters[0]);
+    const Eigen::Vector3d u =
+        inverse_rotation_ ? Eigen::Vector3d(R.transpose() * d_) : Eigen::Vector3d(R * d_);
+    Eigen::Vector3d dr_dv;
+    if (!tardif_distance(l_, m_, K_ * u, weight_, residuals, jacobians ? &dr_dv : nullptr)) {
+      residuals[0] = 0.0;
+      if (jacobians && jacobians[0]) Eigen::Map<RowVector4d>(jacobians[0]).setZero();
+      return true;
+    }
+    if (!jacobians || !jacobians[0]) return true;
+    // Left increment: d(R d)/dw = -[R d]x, d(R^T d)/dw = R^T [d]x.
+    const Eigen::Matrix3d du_dw =
+        inverse_rotation_ ? Eigen::Matrix3d(R.transpose() * skew(d_)) : Eigen::Matrix3d(-skew(u));
+    const Eigen::RowVector3d dr_dw = dr_dv.transpose() * K_ * du_dw;
+    Eigen::Map<RowVector4d> J_q(jacobians[0]);
+    J_q = 2.0 * dr_dw * quaternion_plus_jacobian(parameters[0]).transpose();
+    return true;
+  }
+
+ private:
+  Eigen::Matrix3d K_;  // of the segment's image
+  Eigen::Vector3d l_;  // p1 x p2 in pixels
+  Eigen::Vector2d m_;  // midpoint in pixels
+  Eigen::Vector3d d_;  // unit VP direction in the other camera
+  bool inverse_rotation_;
+  double weight_;
+};
+
+// Line-to-VP consistency with the VP's 3D direction d (camera 1) a parameter: segments of image 1
+// against K1 d, segments of image 2 against K2 R d. The VP is then estimated jointly from all its
+// lines in both views instead of being trusted as detected, so the lines constrain R directly.
+class LineFreeVpCost final : public ceres::SizedCostFunction<1, 4, 3> {
+ public:
+  LineFreeVpCost(const Eigen::Matrix3d& K, const LineSegment& segment, bool second_image,
+                 double weight)
+      : K_(K),
+        l_(homogeneous(segment.p1).cross(homogeneous(segment.p2))),
+        m_(segment.midpoint()),
+        second_image_(second_image),
+        weight_(weight) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Matrix3d R = rotation_of(parameters[0]);
+    const Eigen::Map<const Eigen::Vector3d> d(parameters[1]);
+    const Eigen::Vector3d u = second_image_ ? Eigen::Vector3d(R * d) : Eigen::Vector3d(d);
+    Eigen::Vector3d dr_dv;
+    const bool informative =
+        tardif_distance(l_, m_, K_ * u, weight_, residuals, jacobians ? &dr_dv : nullptr);
+    if (!informative) residuals[0] = 0.0;
+    if (!jacobians) return true;
+    if (jacobians[0]) {
+      Eigen::Map<RowVector4d> J_q(jacobians[0]);
+      if (!informative || !second_image_) {
+        J_q.setZero();
+      } else {
+        const Eigen::RowVector3d dr_dw = dr_dv.transpose() * K_ * (-skew(u));
+        J_q = 2.0 * dr_dw * quaternion_plus_jacobian(parameters[0]).transpose();
+      }
+    }
+    if (jacobians[1]) {
+      Eigen::Map<Eigen::RowVector3d> J_d(jacobians[1]);
+      if (!informative)
+        J_d.setZero();
+      else
+        J_d = second_image_ ? Eigen::RowVector3d(dr_dv.transpose() * K_ * R)
+                            : Eigen::RowVector3d(dr_dv.transpose() * K_);
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Matrix3d K_;
+  Eigen::Vector3d l_;
+  Eigen::Vector2d m_;
+  bool second_image_;
+  double weight_;
+};
+
+bool is_rotation(const Eigen::Matrix3d& R) {
+  return all_finite(R) && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
+         R.determinant() > 0.0;
+}
+
+bool usable_segment(const LineSegment& s) {
+  return all_finite(s.p1) && all_finite(s.p2) && s.length() > 1e-9;
+}
+
+}  // namespace
+
+FinalRefinementResult refine_relative_pose_ceres(
+    const PinholeCamera& camera1, const PinholeCamera& camera2,
+    const std::vector<PointMatch>& points, const std::vector<VpMatch>& vps,
+    const std::vector<LineMatch>& lines, const std::vector<int>& line_vp,
+    const RelativePose& initial, const FinalRefinementOptions& options) {
+  FinalRefinementResult result;
+  result.pose = initial;
+  const double t_norm = initial.t.norm();
+  if (t_norm > 0.0 && std::isfinite(t_norm)) result.pose.t /= t_norm;
+  if (!camera1.valid() || !camera2.valid() || !is_rotation(initial.R) || !all_finite(initial.t))
+    return result;
+  const double scales[] = {options.point_loss_px, options.vp_loss_deg, options.vp_weight,
+                           options.line_vp_weight};
+  for (double value : scales)
+    if (!std::isfinite(value)) return result;
+  // Points need a direction to start t from.
+  if (!points.empty() && !(t_norm > 0.0 && std::isfinite(t_norm))) return result;
+
+  // Parameters: Eigen quaternion (x, y, z, w) and the unit t.
+  Eigen::Quaterniond rotation(initial.R);
+  rotation.normalize();
+  double q[4] = {rotation.x(), rotation.y(), rotation.z(), rotation.w()};
+  double t[3] = {result.pose.t.x(), result.pose.t.y(), result.pose.t.z()};
+
+  // Loss functions are shared by their residuals and outlive the problem.
+  const double f_vp = 0.5 * (camera1.mean_focal() + camera2.mean_focal());
+  const double vp_scale = options.vp_weight * f_vp;
+  std::unique_ptr<ceres::LossFunction> point_loss, vp_loss, line_loss;
+  if (options.point_loss_px > 0.0) point_loss.reset(new ceres::CauchyLoss(options.point_loss_px));
+  if (options.vp_loss_deg > 0.0 && vp_scale > 0.0)
+    vp_loss.reset(new ceres::CauchyLoss(vp_scale * options.vp_loss_deg * kDegree));
+  if (options.point_loss_px > 0.0 && options.line_vp_weight > 0.0)
+    line_loss.reset(new ceres::CauchyLoss(options.line_vp_weight * options.point_loss_px));
+
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.disable_all_safety_checks = true;  // we add each block once, with its sizes
+  ceres::Problem problem(problem_options);
+  problem.AddParameterBlock(q, 4, new ceres::EigenQuaternionManifold);
+
+  const Eigen::Vector2d w1(1.0 / (camera1.fx * camera1.fx), 1.0 / (camera1.fy * camera1.fy));
+  const Eigen::Vector2d w2(1.0 / (camera2.fx * camera2.fx), 1.0 / (camera2.fy * camera2.fy));
+  for (const PointMatch& m : points) {
+    if (!all_finite(m.x1) || !all_finite(m.x2)) continue;
+    if (result.num_point_residuals == 0)
+      problem.AddParameterBlock(t, 3, new ceres::SphereManifold<3>);
+    problem.AddResidualBlock(new PointSampsonCost(homogeneous(camera1.normalize(m.x1)),
+                                                  homogeneous(camera2.normalize(m.x2)), w1, w2),
+                             point_loss.get(), q, t);
+    ++result.num_point_residuals;
+  }
+
+  // VPs with a usable direction; lines may only name these (also when VPs are weighted out).
+  std::vector<char> vp_ok(vps.size(), 0);
+  for (size_t k = 0; k < vps.size(); ++k)
+    vp_ok[k] = all_finite(vps[k].d1) && all_finite(vps[k].d2) && vps[k].d1.norm() > 0.0 &&
+               vps[k].d2.norm() > 0.0;
+  // Labelled segments per VP and image; a VP with two or more in each image gets its direction
+  // refined from them (its detected directions were fitted on the same segments, so its VP
+  // residual would count them twice and is dropped).
+  std::vector<std::vector<int>> labelled(vps.size());
+  std::vector<int> count1(vps.size(), 0), count2(vps.size(), 0);
+  if (options.line_vp_weight > 0.0) {
+    for (size_t i = 0; i < lines.size() && i < line_vp.size(); ++i) {
+      const int k = line_vp[i];
+      if (k < 0 || k >= static_cast<int>(vps.size()) || !vp_ok[k]) continue;
+      labelled[k].push_back(static_cast<int>(i));
+      count1[k] += usable_segment(lines[i].s1);
+      count2[k] += usable_segment(lines[i].s2);
+    }
+  }
+  std::vector<Eigen::Vector3d> directions(vps.size());
+  int free_vps = 0;
+  const Eigen::Matrix3d K1 = camera1.K(), K2 = camera2.K();
+  for (size_t k = 0; k < vps.size(); ++k) {
+    if (!vp_ok[k]) continue;
+    const Eigen::Vector3d d1 = vps[k].d1.normalized(), d2 = vps[k].d2.normalized();
+    if (options.refine_vp_directions && count1[k] >= 2 && count2[k] >= 2) {
+      directions[k] = d1;
+      problem.AddParameterBlock(directions[k].data(), 3, new ceres::SphereManifold<3>);
+      ++free_vps;
+      for (int i : labelled[k]) {
+        for (const bool second : {false, true}) {
+          const LineSegment& segment = second ? lines[i].s2 : lines[i].s1;
+          if (!usable_segment(segment)) continue;
+          problem.AddResidualBlock(
+              new LineFreeVpCost(second ? K2 : K1, segment, second, options.line_vp_weight),
+              line_loss.get(), q, directions[k].data());
+          ++result.num_line_residuals;
+        }
+      }
+      continue;
+    }
+    if (vp_scale > 0.0) {
+      problem.AddResidualBlock(new VpAngleCost(d1, d2, vps[k].sign_known, vp_scale),
+                               vp_loss.get(), q);
+      ++result.num_vp_residuals;
+    }
+    for (int i : labelled[k]) {
+      if (usable_segment(lines[i].s2)) {
+        problem.AddResidualBlock(new LineVpCost(K2, lines[i].s2, d1, false, options.line_vp_weight),
+                                 line_loss.get(), q);
+        ++result.num_line_residuals;
+      }
+      if (usable_segment(lines[i].s1)) {
+        problem.AddResidualBlock(new LineVpCost(K1, lines[i].s1, d2, true, options.line_vp_weight),
+                                 line_loss.get(), q);
+        ++result.num_line_residuals;
+      }
+    }
+  }
+  result.num_refined_vps = free_vps;
+
+  // At least five residual rows, and no fewer independent ones (a VP's three rows have rank two)
+  // than free parameters: three for R, two more for t when points are used, two per free VP.
+  const int parameters = (result.num_point_residuals > 0 ? 5 : 3) + 2 * free_vps;
+  const int ceres_rows =
+      result.num_point_residuals + 3 * result.num_vp_residuals + result.num_line_residuals;
+  const int rows = ceres_rows - result.num_vp_residuals;
+  if (ceres_rows < 5 || rows < parameters) return result;
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.num_threads = 1;
+  solver_options.max_num_iterations = std::max(0, options.max_iterations);
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.parameter_tolerance = options.parameter_tolerance;
+  solver_options.gradient_tolerance = 1e-16;
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = false;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+
+  RelativePose refined;
+  refined.R = rotation_of(q);
+  refined.t = result.num_point_residuals > 0 ? Eigen::Vector3d(t[0], t[1], t[2]).normalized()
+                                             : result.pose.t;
+  if (!summary.IsSolutionUsable() || !all_finite(refined.R) || !all_finite(refined.t) ||
+      !std::isfinite(summary.final_cost))
+    return result;
+  result.success = true;
+  result.pose = refined;
+  result.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+
+  // Covariance: needs t in the problem and redundancy to estimate sigma^2.
+  if (!options.compute_covariance || result.num_point_residuals == 0 || rows <= parameters)
+    return result;
+  // DENSE_SVD (5 columns) with automatic truncation: singular values of J below 1e-5 of the
+  // largest are dropped, which we detect below as a rank-deficient result. (Without truncation
+  // Ceres reports rank deficiency through glog at ERROR level.)
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.null_space_rank = -1;
+  covariance_options.min_reciprocal_condition_number = 1e-10;
+  covariance_options.num_threads = 1;
+  ceres::Covariance covariance(covariance_options);
+  const std::vector<const double*> blocks = {q, t};
+  Eigen::Matrix<double, 5, 5, Eigen::RowMajor> tangent_covariance;
+  if (!covariance.Compute(blocks, &problem) ||
+      !covariance.GetCovarianceMatrixInTangentSpace(blocks, tangent_covariance.data()) ||
+      !all_finite(tangent_covariance))
+    return result;
+  // Kept directions have eigenvalues >= 1e-10 of the largest, dropped ones are zero to rounding.
+  const Eigen::Matrix<double, 5, 5> symmetric =
+      0.5 * (tangent_covariance + tangent_covariance.transpose());
+  const Eigen::Matrix<double, 5, 1> eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>>(symmetric, Eigen::EigenvaluesOnly)
+          .eigenvalues();
+  if (!(eigenvalues(0) > 1e-12 * eigenvalues(4))) return result;
+  // Tangent [d (quaternion), 2 sphere coordinates] to [w = 2 d, t]: t's tangent basis is the
+  // sphere manifold's Plus Jacobian at t.
+  Eigen::Matrix<double, 3, 2, Eigen::RowMajor> t_basis;
+  ceres::SphereManifold<3>().PlusJacobian(t, t_basis.data());
+  Eigen::Matrix<double, 6, 5> J = Eigen::Matrix<double, 6, 5>::Zero();
+  J.topLeftCorner<3, 3>() = 2.0 * Eigen::Matrix3d::Identity();
+  J.bottomRightCorner<3, 2>() = t_basis;
+  result.sigma2 = 2.0 * result.final_cost / (rows - parameters);
+  const Eigen::Matrix<double, 6, 6> full = result.sigma2 * J * symmetric * J.transpose();
+  if (!all_finite(full)) return result;
+  result.covariance = 0.5 * (full + full.transpose());
+  result.covariance_valid = true;
+  return result;
+}
+
+}  // namespace hybrid_vo

@@ -1,0 +1,64 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "hybrid_vo/estimation/derived_matches.h"
+
+namespace hybrid_vo {
+namespace {
+
+LineMatch match(Eigen::Vector2d a, Eigen::Vector2d b, Eigen::Vector2d shift = {5.0, -3.0}) {
+  return {LineSegment(a, b), LineSegment(a + shift, b + shift)};
+}
+
+TEST(Junctions, CrossingSegmentsMeetOnBoth) {
+  const std::vector<LineMatch> lines = {match({0, 0}, {100, 0}), match({50, -40}, {50, 60})};
+  const auto junctions = find_junctions(lines);
+  ASSERT_EQ(junctions.size(), 1u);
+  EXPECT_EQ(junctions[0].source, PointSource::kJunction);
+  EXPECT_EQ(junctions[0].first, 0);
+  EXPECT_EQ(junctions[0].second, 1);
+  EXPECT_LT((junctions[0].match.x1 - Eigen::Vector2d(50, 0)).norm(), 1e-12);
+  EXPECT_LT((junctions[0].match.x2 - Eigen::Vector2d(55, -3)).norm(), 1e-12);
+}
+
+TEST(Junctions, ToleranceBeyondTheEnds) {
+  // The second segment stops 2 px short of the first (an L corner with a detector gap).
+  const std::vector<LineMatch> lines = {match({0, 0}, {100, 0}), match({102, 2}, {102, 80})};
+  JunctionOptions options;
+  options.tolerance_px = 3.0;
+  EXPECT_EQ(find_junctions(lines, options).size(), 1u);
+  options.tolerance_px = 1.0;
+  EXPECT_EQ(find_junctions(lines, options).size(), 0u);
+}
+
+TEST(Junctions, MustHoldInBothImages) {
+  std::vector<LineMatch> lines = {match({0, 0}, {100, 0}), match({50, -40}, {50, 60})};
+  lines[1].s2 = LineSegment({200, 10}, {200, 90});  // far from the other segment in image 2
+  EXPECT_TRUE(find_junctions(lines).empty());
+}
+
+TEST(Junctions, ParallelShallowAndInvalidSegmentsFormNone) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<LineMatch> lines = {
+      match({0, 0}, {100, 0}), match({0, 10}, {100, 10}),        // parallel
+      match({0, 1}, {100, 6}),                                    // ~3 degrees: too shallow
+      match({50, -40}, {50, -40}),                                // zero length
+      match({nan, 0}, {50, 60})};                                 // not finite
+  EXPECT_TRUE(find_junctions(lines).empty());
+}
+
+TEST(Endpoints, PairedSoThatSegmentsPointTheSameWay) {
+  std::vector<LineMatch> lines = {match({0, 0}, {100, 0})};
+  lines[0].s2 = LineSegment({105, -3}, {5, -3});  // stored the other way round in image 2
+  const auto ends = segment_endpoints(lines);
+  ASSERT_EQ(ends.size(), 2u);
+  EXPECT_EQ(ends[0].source, PointSource::kEndpoint);
+  EXPECT_LT((ends[0].match.x2 - Eigen::Vector2d(5, -3)).norm(), 1e-12);
+  EXPECT_LT((ends[1].match.x2 - Eigen::Vector2d(105, -3)).norm(), 1e-12);
+  lines.push_back(match({1, 1}, {1, 1}));  // zero length: no endpoints
+  EXPECT_EQ(segment_endpoints(lines).size(), 2u);
+}
+
+}  // namespace
+}  // namespace hybrid_vo
