@@ -67,6 +67,19 @@ TEST(PoseError, AccurateForTinyAngles) {
   EXPECT_NEAR(pose_error(a, b), std::max(0.1, std::atan(0.2)), 1e-12);
 }
 
+TEST(PoseError, AucMatchesTheSuperGlueDefinition) {
+  // All errors zero: full area. All failures: none.
+  EXPECT_DOUBLE_EQ(pose_auc({0.0, 0.0}, 10.0), 1.0);
+  EXPECT_DOUBLE_EQ(pose_auc({180.0, INFINITY, NAN}, 10.0), 0.0);
+  // One pair at 5 of 10, one failed: the trapezoid (0,0)-(5,0.5) then 0.5 up to 10.
+  EXPECT_NEAR(pose_auc({5.0, 180.0}, 10.0), 0.375, 1e-12);
+  // Uniform errors over [0, 10] approach a triangle: area 0.5.
+  std::vector<double> uniform;
+  for (int i = 0; i < 10000; ++i) uniform.push_back(10.0 * (i + 0.5) / 10000);
+  EXPECT_NEAR(pose_auc(uniform, 10.0), 0.5, 1e-3);
+  EXPECT_EQ(pose_auc({}, 10.0), 0.0);
+}
+
 TEST(Pose, RelativeFromWorldToCameraAndEssential) {
   std::mt19937_64 rng(4);
   const Eigen::Matrix3d R1 = random_rotation(rng), R2 = random_rotation(rng);

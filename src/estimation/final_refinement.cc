@@ -9,6 +9,7 @@
 #include <ceres/ceres.h>
 
 #include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/geometry/vp_distance.h"
 
 namespace hybrid_vo {
 namespace {
@@ -117,23 +118,12 @@ class VpAngleCost final : public ceres::SizedCostFunction<3, 4> {
   double scale_;
 };
 
-// Tardif's (2009) orthogonal distance, in pixels, of a segment (l = p1 x p2, midpoint m) to the
-// VP v: the distance of an endpoint p1 to the line m x v through the midpoint and v. Since
-// p1 x m = (p1 x p2) / 2 = l / 2 it is (v . l / 2) / |v_xy - v_z m|, defined for a VP at infinity
-// too (v_z = 0) and independent of the scale and sign of v. Writes dr/dv when asked; returns
-// false when v sits at the midpoint (every line through it passes the VP: no information).
+// Tardif's distance (geometry/vp_distance.h) times a weight, with its gradient.
 bool tardif_distance(const Eigen::Vector3d& l, const Eigen::Vector2d& m, const Eigen::Vector3d& v,
                      double weight, double* r, Eigen::Vector3d* dr_dv) {
-  const Eigen::Vector2d g = v.head<2>() - v.z() * m;
-  const double g_norm = g.norm();
-  if (!(g_norm > 1e-12 * v.norm())) return false;
-  const double n = 0.5 * v.dot(l);
-  *r = weight * n / g_norm;
-  if (dr_dv) {
-    // dr/dv = w (l / 2 / |g| - n A^T g / |g|^3), A = [I2, -m].
-    const Eigen::Vector3d A_t_g(g.x(), g.y(), -m.dot(g));
-    *dr_dv = weight * (0.5 * l / g_norm - n / (g_norm * g_norm * g_norm) * A_t_g);
-  }
+  if (!hybrid_vo::tardif_distance(l, m, v, r, dr_dv)) return false;
+  *r *= weight;
+  if (dr_dv) *dr_dv *= weight;
   return true;
 }
 

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "hybrid_problem.h"
+#include "hybrid_vo/geometry/cheirality.h"
 #include "hybrid_ransac.h"
 #include "model_scorer.h"
 
@@ -59,6 +60,22 @@ void fill_inliers(const HybridProblem& problem, const ModelScorer& scorer,
   est->num_vp_inliers = count(est->vp_inliers);
   est->num_junction_inliers = count(est->junction_inliers);
   est->num_endpoint_inliers = count(est->endpoint_inliers);
+}
+
+void orient_by_inliers(const HybridProblem& problem, const ModelScorer& scorer, RelativePose* pose) {
+  std::vector<char> pool;
+  scorer.pool_inliers(*pose, &pool);
+  std::vector<Eigen::Vector2d> x1, x2;
+  for (int i = 0; i < problem.num_pool(); ++i) {
+    if (!pool[i]) continue;
+    x1.push_back(problem.n1[i]);
+    x2.push_back(problem.n2[i]);
+  }
+  MatchView view;
+  view.x1 = x1.data();
+  view.x2 = x2.data();
+  view.num_points = static_cast<int>(x1.size());
+  orient_translation_by_majority(pose->R, &pose->t, view);
 }
 
 // Ceres refinement on the inliers (paper Sec. 4, final step); kept unless it loses inliers.
@@ -217,6 +234,9 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
     refine_final(problem, scorer, options, matches, &est);
     est.refine_ms = ms_since(refine_start);
   }
+  // The Sampson error cannot tell t from -t, and the minimal sample that fixed the sign was
+  // tiny: the inliers vote on it (depths in front of both cameras).
+  orient_by_inliers(problem, scorer, &est.pose);
   fill_inliers(problem, scorer, options, matches, &est);
   return finish(EstimationStatus::kOk);
 }

@@ -62,6 +62,23 @@ int vote_of_segment(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const Li
 
 }  // namespace
 
+int orient_translation_by_majority(const Eigen::Matrix3d& R, Eigen::Vector3d* t,
+                                   const MatchView& matches) {
+  int positive = 0, negative = 0;
+  for (int i = 0; i < matches.num_points; ++i) {
+    const int vote = vote_of_point(R, *t, matches.x1[i], matches.x2[i]);
+    positive += vote == 1;
+    negative += vote == -1;
+  }
+  for (int i = 0; i < matches.num_segments; ++i) {
+    const int vote = vote_of_segment(R, *t, matches.s1[i], matches.s2[i]);
+    positive += vote == 1;
+    negative += vote == -1;
+  }
+  if (negative > positive) *t = -*t;
+  return std::abs(positive - negative);
+}
+
 bool orient_translation(const Eigen::Matrix3d& R, Eigen::Vector3d* t, const MatchView& matches) {
   int sign = 0;
   for (int i = 0; i < matches.num_points && sign != kConflict; ++i)

@@ -24,4 +24,23 @@ double pose_error(const RelativePose& estimate, const RelativePose& truth) {
   return std::max(rotation_error(estimate.R, truth.R), translation_error(estimate.t, truth.t));
 }
 
+double pose_auc(std::vector<double> errors, double threshold) {
+  if (errors.empty() || !(threshold > 0.0)) return 0.0;
+  for (double& e : errors)
+    if (!std::isfinite(e)) e = INFINITY;
+  std::sort(errors.begin(), errors.end());
+  const double n = static_cast<double>(errors.size());
+  // Trapezoids through the points (e_k, k / n) from (0, 0), cut at the threshold: exactly
+  // SuperGlue's np.trapz, which the published AUC numbers use.
+  double area = 0.0, previous_error = 0.0, previous_recall = 0.0;
+  for (size_t k = 0; k < errors.size() && errors[k] <= threshold; ++k) {
+    const double recall = (k + 1) / n;
+    area += (errors[k] - previous_error) * 0.5 * (previous_recall + recall);
+    previous_error = errors[k];
+    previous_recall = recall;
+  }
+  area += (threshold - previous_error) * previous_recall;
+  return area / threshold;
+}
+
 }  // namespace hybrid_vo

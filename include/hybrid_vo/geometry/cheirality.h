@@ -23,4 +23,10 @@ struct MatchView {
 // whose plane contains the baseline) say nothing and are skipped.
 bool orient_translation(const Eigen::Matrix3d& R, Eigen::Vector3d* t, const MatchView& matches);
 
+// Same test with a majority vote instead of unanimity, for a model fitted to many noisy matches:
+// flips t when more matches lie in front with -t than with t. Returns the margin of votes for the
+// chosen sign (0: undecided, t kept).
+int orient_translation_by_majority(const Eigen::Matrix3d& R, Eigen::Vector3d* t,
+                                   const MatchView& matches);
+
 }  // namespace hybrid_vo

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
 
 #include "hybrid_vo/geometry/pose.h"
@@ -14,5 +16,10 @@ double translation_error(const Eigen::Vector3d& t_a, const Eigen::Vector3d& t_b)
 
 // max(rotation error, translation error): the pose error behind AUC@5/10/20 (DESIGN.md).
 double pose_error(const RelativePose& estimate, const RelativePose& truth);
+
+// Area under the cumulative error curve up to `threshold` (same unit as the errors), normalised
+// to [0, 1]: the AUC@5/10/20 degrees of SuperGlue, LoFTR and the paper. A failure counts with an
+// error above every threshold (e.g. 180 degrees).
+double pose_auc(std::vector<double> errors, double threshold);
 
 }  // namespace hybrid_vo
