@@ -1,0 +1,419 @@
+// The VP tracker: stable ids on a rotating Manhattan sequence, smoothing, dropping and creating
+// tracks, clutter, feeding confident tracks to the next pair's VP matches, bad input and reset.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <set>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/geometry/rotation.h"
+#include "hybrid_vo/lines/vp_tracker.h"
+
+namespace hybrid_vo {
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+const std::vector<Eigen::Vector3d> kManhattan = {
+    Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
+
+// Sign-agnostic angle between two directions, in degrees.
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const Eigen::Vector3d u = a.normalized(), v = b.normalized();
+  return std::atan2(u.cross(v).norm(), std::abs(u.dot(v))) / kDeg;
+}
+
+// Camera k of a camera yawing 2 degrees per frame about the world's vertical (y), from a generic
+// tilted start so that no axis of the camera is aligned with the scene.
+Eigen::Matrix3d camera_to_world(int k) {
+  const Eigen::Matrix3d start = rotation_about(Eigen::Vector3d(1, 2, 3).normalized(), 0.4);
+  return rotation_about(Eigen::Vector3d::UnitY(), 2.0 * k * kDeg) * start;
+}
+
+// A detected VP: the true direction tilted by a Gaussian angle of sigma_deg along each of two
+// tangent axes, with a random sign and scale (a VP is K^-1 v of any scale and either sign).
+Eigen::Vector3d detect(const Eigen::Vector3d& d, double sigma_deg, std::mt19937* rng) {
+  std::normal_distribution<double> noise(0.0, sigma_deg * kDeg);
+  std::uniform_real_distribution<double> scale(0.5, 5.0);
+  const Eigen::Vector3d u = d.unitOrthogonal(), v = d.cross(u).normalized();
+  const Eigen::Vector3d tilted =
+      (d.normalized() + std::tan(noise(*rng)) * u + std::tan(noise(*rng)) * v).normalized();
+  return ((*rng)() % 2 ? 1.0 : -1.0) * scale(*rng) * tilted;
+}
+
+// A direction at least `min_deg` from every Manhattan axis.
+Eigen::Vector3d clutter_direction(std::mt19937* rng, double min_deg = 10.0) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (;;) {
+    const Eigen::Vector3d d = Eigen::Vector3d(g(*rng), g(*rng), g(*rng)).normalized();
+    bool far = true;
+    for (const auto& axis : kManhattan) far = far && angle_deg(d, axis) >= min_deg;
+    if (far) return d;
+  }
+}
+
+// One frame: the world directions `visible` detected by camera k and passed to the tracker in a
+// random order. Returns the tracker's ids in the order of `visible`; `raw_world` gets the
+// detections rotated back into the world.
+std::vector<int> observe(VpTracker* tracker, int k, const std::vector<Eigen::Vector3d>& visible,
+                         double sigma_deg, std::mt19937* rng,
+                         std::vector<Eigen::Vector3d>* raw_world = nullptr) {
+  const Eigen::Matrix3d R_wc = camera_to_world(k);
+  std::vector<int> which(visible.size());
+  std::iota(which.begin(), which.end(), 0);
+  std::shuffle(which.begin(), which.end(), *rng);
+  std::vector<Eigen::Vector3d> directions;
+  for (const int i : which)
+    directions.push_back(detect(R_wc.transpose() * visible[i], sigma_deg, rng));
+  const std::vector<int> ids = tracker->update(R_wc, directions);
+  std::vector<int> by_visible(visible.size(), -2);
+  if (raw_world) raw_world->assign(visible.size(), Eigen::Vector3d::Zero());
+  for (size_t j = 0; j < which.size(); ++j) {
+    by_visible[which[j]] = ids[j];
+    if (raw_world) (*raw_world)[which[j]] = R_wc * directions[j];
+  }
+  return by_visible;
+}
+
+bool all_tracks_finite(const VpTracker& tracker) {
+  for (const VpTrack& t : tracker.tracks())
+    if (!all_finite(t.direction) || !std::isfinite(t.weight) || !std::isfinite(t.last_angle_deg) ||
+        std::abs(t.direction.norm() - 1.0) > 1e-12)
+      return false;
+  return true;
+}
+
+TEST(VpTracker, RotatingManhattanKeepsThreeSmoothedTracks) {
+  std::mt19937 rng(1);
+  VpTracker tracker;
+  std::vector<int> ids0;
+  double raw_error = 0.0, smoothed_error = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    std::vector<Eigen::Vector3d> raw;
+    const std::vector<int> ids = observe(&tracker, k, kManhattan, 0.3, &rng, &raw);
+    if (k == 0) ids0 = ids;
+    ASSERT_EQ(ids, ids0) << "frame " << k;
+    ASSERT_EQ(tracker.tracks().size(), 3u) << "frame " << k;
+    if (k < 30) continue;  // let the mean fill up
+    for (int a = 0; a < 3; ++a) {
+      raw_error += angle_deg(raw[a], kManhattan[a]);
+      smoothed_error += angle_deg(tracker.find(ids0[a])->direction, kManhattan[a]);
+    }
+  }
+  EXPECT_EQ(std::set<int>(ids0.begin(), ids0.end()).size(), 3u);
+  for (int a = 0; a < 3; ++a) {
+    const VpTrack* track = tracker.find(ids0[a]);
+    ASSERT_NE(track, nullptr);
+    EXPECT_LT(angle_deg(track->direction, kManhattan[a]), 0.3) << "axis " << a;
+    EXPECT_TRUE(track->confident);
+    EXPECT_EQ(track->hits, 100);
+    EXPECT_EQ(track->misses, 0);
+    EXPECT_EQ(track->age, 99);
+    EXPECT_LT(track->last_angle_deg, 3.0);
+  }
+  // Smoothing is what makes the tracks better than single detections.
+  EXPECT_LT(smoothed_error, 0.4 * raw_error);
+  EXPECT_TRUE(all_tracks_finite(tracker));
+}
+
+TEST(VpTracker, TrackLeavingTheViewIsDroppedAfterMaxMisses) {
+  std::mt19937 rng(2);
+  VpTracker tracker;
+  const int max_misses = tracker.options().max_misses;
+  std::vector<int> ids0;
+  for (int k = 0; k < 100; ++k) {
+    // The camera has turned far enough that the z direction's lines left the image.
+    const std::vector<Eigen::Vector3d> visible =
+        k <= 40 ? kManhattan : std::vector<Eigen::Vector3d>{kManhattan[0], kManhattan[1]};
+    const std::vector<int> ids = observe(&tracker, k, visible, 0.3, &rng);
+    if (k == 0) ids0 = ids;
+    EXPECT_EQ(ids[0], ids0[0]);
+    EXPECT_EQ(ids[1], ids0[1]);
+    const VpTrack* z = tracker.find(ids0[2]);
+    if (k <= 40 + max_misses) {
+      ASSERT_NE(z, nullptr) << "frame " << k;
+      EXPECT_EQ(z->misses, std::max(0, k - 40));
+      EXPECT_EQ(z->confident, k >= tracker.options().confirm_hits - 1);
+    } else {
+      EXPECT_EQ(z, nullptr) << "frame " << k;
+    }
+  }
+  ASSERT_EQ(tracker.tracks().size(), 2u);
+  EXPECT_NE(tracker.find(ids0[0]), nullptr);
+  EXPECT_NE(tracker.find(ids0[1]), nullptr);
+}
+
+TEST(VpTracker, NewDirectionsGetNewIdsNeverReusedOnes) {
+  std::mt19937 rng(3);
+  VpTracker tracker;
+  const int confirm = tracker.options().confirm_hits;
+  const Eigen::Vector3d atlanta = Eigen::Vector3d(1, 0, 1).normalized();  // a 45-degree facade
+  std::set<int> seen;
+  int z_old = -1, atlanta_id = -1, z_new = -1;
+  for (int k = 0; k < 100; ++k) {
+    std::vector<Eigen::Vector3d> visible = {kManhattan[0], kManhattan[1]};
+    if (k >= 60) visible.push_back(atlanta);
+    if (k <= 40 || k >= 70) visible.push_back(kManhattan[2]);  // z leaves, is dropped, returns
+    const std::vector<int> ids = observe(&tracker, k, visible, 0.3, &rng);
+    if (k == 0) z_old = ids[2];
+    if (k == 60) {
+      atlanta_id = ids[2];
+      EXPECT_GT(atlanta_id, *seen.rbegin());
+    }
+    if (k == 70) {
+      z_new = ids.back();
+      EXPECT_EQ(tracker.find(z_old), nullptr);
+      EXPECT_GT(z_new, *seen.rbegin());
+      EXPECT_NE(z_new, z_old);
+    }
+    if (k >= 60) {
+      const VpTrack* track = tracker.find(atlanta_id);
+      ASSERT_NE(track, nullptr);
+      EXPECT_EQ(track->confident, k - 60 + 1 >= confirm) << "frame " << k;
+      EXPECT_EQ(ids[2], atlanta_id);
+    }
+    seen.insert(ids.begin(), ids.end());
+  }
+  EXPECT_EQ(seen.size(), 5u);  // x, y, old z, Atlanta, new z
+  EXPECT_EQ(tracker.tracks().size(), 4u);
+  EXPECT_LT(angle_deg(tracker.find(atlanta_id)->direction, atlanta), 0.3);
+  EXPECT_LT(angle_deg(tracker.find(z_new)->direction, kManhattan[2]), 0.3);
+}
+
+TEST(VpTracker, ClutterNeverBecomesConfidentAndIsDropped) {
+  std::mt19937 rng(4);
+  VpTracker tracker;
+  const int max_misses = tracker.options().max_misses;
+  std::vector<int> ids0;
+  std::vector<std::pair<int, int>> clutter;  // (frame, id)
+  for (int k = 0; k < 100; ++k) {
+    std::vector<Eigen::Vector3d> visible = kManhattan;
+    if (k % 4 == 1) visible.push_back(clutter_direction(&rng));
+    const std::vector<int> ids = observe(&tracker, k, visible, 0.3, &rng);
+    if (k == 0) ids0 = ids;
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(ids[a], ids0[a]) << "frame " << k;
+    if (visible.size() == 4) {
+      EXPECT_GE(ids[3], 0);
+      clutter.emplace_back(k, ids[3]);
+    }
+    for (const auto& [frame, id] : clutter) {
+      const VpTrack* track = tracker.find(id);
+      if (k <= frame + max_misses) {
+        ASSERT_NE(track, nullptr);
+        EXPECT_FALSE(track->confident);
+        EXPECT_EQ(track->hits, 1);
+      } else {
+        EXPECT_EQ(track, nullptr);
+      }
+    }
+    EXPECT_LE(tracker.tracks().size(), 5u);  // 3 + at most two live clutter tracks
+  }
+  EXPECT_EQ(clutter.size(), 25u);
+  int confident = 0;
+  for (const VpTrack& t : tracker.tracks()) confident += t.confident;
+  EXPECT_EQ(confident, 3);
+}
+
+TEST(VpTracker, RefineMatchesUsesConfidentTracksOnly) {
+  std::mt19937 rng(5);
+  VpTracker tracker;
+  std::vector<int> ids;
+  const int k1 = 19;
+  for (int k = 0; k <= k1; ++k) {
+    // z is seen only in the last two frames: not yet confident.
+    std::vector<Eigen::Vector3d> visible = {kManhattan[0], kManhattan[1]};
+    if (k >= k1 - 1) visible.push_back(kManhattan[2]);
+    ids = observe(&tracker, k, visible, 0.3, &rng);
+  }
+  ASSERT_FALSE(tracker.find(ids[2])->confident);
+
+  // The next pair (k1, k1 + 1): x with a known sign, y, y again (one match per track), z, and a
+  // direction without a track.
+  const Eigen::Matrix3d R_wc1 = camera_to_world(k1), R_wc2 = camera_to_world(k1 + 1);
+  const Eigen::Matrix3d R = R_wc2.transpose() * R_wc1;  // X2 = R X1 + t
+  const std::vector<Eigen::Vector3d> world = {kManhattan[0], kManhattan[1], kManhattan[1],
+                                              kManhattan[2], Eigen::Vector3d(1, 1, 0).normalized()};
+  // Detections in camera 1 tilted by 0.5 degrees (the second y by 1.5), with either sign.
+  const std::vector<double> tilt_deg = {0.5, 0.5, 1.5, 0.5, 0.5};
+  const std::vector<double> sign = {1.0, -1.0, 1.0, -1.0, 1.0};
+  std::vector<VpMatch> matches;
+  for (size_t i = 0; i < world.size(); ++i) {
+    const Eigen::Vector3d truth = R_wc1.transpose() * world[i];
+    VpMatch m;
+    m.d1 = 2.0 * sign[i] * rotation_about(truth.unitOrthogonal(), tilt_deg[i] * kDeg) * truth;
+    m.d2 = R * m.d1.normalized();
+    m.sign_known = i == 0;
+    matches.push_back(m);
+  }
+  const std::vector<VpMatch> before = matches;
+  const std::vector<int> replaced = tracker.refine_matches(R_wc1, &matches);
+  ASSERT_EQ(replaced.size(), matches.size());
+  EXPECT_EQ(replaced[0], ids[0]);
+  EXPECT_EQ(replaced[1], ids[1]);  // the closer of the two y matches
+  EXPECT_EQ(replaced[2], -1);
+  EXPECT_EQ(replaced[3], -1);      // z: not confident
+  EXPECT_EQ(replaced[4], -1);      // no track
+  for (int i : {0, 1}) {
+    const Eigen::Vector3d truth = R_wc1.transpose() * world[i];
+    EXPECT_LT(angle_deg(matches[i].d1, truth), 0.2) << i;
+    EXPECT_NEAR(matches[i].d1.norm(), 1.0, 1e-12);
+    EXPECT_GT(matches[i].d1.dot(before[i].d1), 0.0) << "sign of d1 kept";
+    // The track is the same direction the old d1 pointed at, in camera 1.
+    EXPECT_LT(angle_deg(R_wc1 * matches[i].d1, tracker.find(replaced[i])->direction), 1e-9);
+  }
+  for (size_t i = 0; i < matches.size(); ++i) {
+    EXPECT_EQ(matches[i].d2, before[i].d2);
+    EXPECT_EQ(matches[i].sign_known, before[i].sign_known);
+    if (replaced[i] < 0) {
+      EXPECT_EQ(matches[i].d1, before[i].d1) << i;
+    }
+  }
+  // With a known sign, d2 = +R d1 still holds to the noise level.
+  EXPECT_GT(matches[0].d2.dot(R * matches[0].d1), 0.99);
+
+  // An invalid rotation or no matches change nothing.
+  std::vector<VpMatch> again = before;
+  EXPECT_EQ(tracker.refine_matches(2.0 * R_wc1, &again), std::vector<int>(before.size(), -1));
+  for (size_t i = 0; i < again.size(); ++i) EXPECT_EQ(again[i].d1, before[i].d1);
+  EXPECT_TRUE(tracker.refine_matches(R_wc1, nullptr).empty());
+}
+
+TEST(VpTracker, BadInputChangesNothingAndNeverGivesNan) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  std::mt19937 rng(6);
+  VpTracker tracker;
+  std::vector<int> axis_ids;
+  for (int k = 0; k < 5; ++k) axis_ids = observe(&tracker, k, kManhattan, 0.3, &rng);
+  const std::vector<VpTrack> before = tracker.tracks();
+  const Eigen::Matrix3d R = camera_to_world(5);
+  const std::vector<Eigen::Vector3d> good = {R.transpose() * kManhattan[0]};
+
+  // Invalid rotations and mismatched weights: nothing happens, not even ageing.
+  Eigen::Matrix3d with_nan = R;
+  with_nan(1, 2) = nan;
+  Eigen::Matrix3d sheared = R;
+  sheared(0, 1) += 1e-3;
+  for (const Eigen::Matrix3d& bad :
+       {with_nan, Eigen::Matrix3d(2.0 * R), Eigen::Matrix3d(-R), sheared,
+        Eigen::Matrix3d(Eigen::Matrix3d::Zero())}) {
+    EXPECT_EQ(tracker.update(bad, good), std::vector<int>{-1});
+  }
+  EXPECT_EQ(tracker.update(R, good, {1.0, 2.0}), std::vector<int>{-1});
+  ASSERT_EQ(tracker.tracks().size(), before.size());
+  for (size_t j = 0; j < before.size(); ++j) {
+    EXPECT_EQ(tracker.tracks()[j].age, before[j].age);
+    EXPECT_EQ(tracker.tracks()[j].direction, before[j].direction);
+  }
+
+  // Invalid directions and weights are ignored one by one; the valid one still counts.
+  const std::vector<Eigen::Vector3d> mixed = {
+      Eigen::Vector3d(nan, 0, 1), Eigen::Vector3d::Zero(), Eigen::Vector3d(inf, 0, 0),
+      R.transpose() * kManhattan[1], R.transpose() * kManhattan[2], 1e300 * good[0]};
+  const std::vector<int> ids = tracker.update(R, mixed, {1.0, 1.0, 1.0, nan, -1.0, 1.0});
+  EXPECT_EQ(ids, (std::vector<int>{-1, -1, -1, -1, -1, axis_ids[0]}));
+  EXPECT_EQ(tracker.tracks().size(), 3u);
+  EXPECT_EQ(tracker.find(axis_ids[0])->misses, 0);
+  EXPECT_EQ(tracker.find(axis_ids[1])->misses, 1);
+  EXPECT_TRUE(all_tracks_finite(tracker));
+
+  // Empty frames count as misses, then drop everything.
+  for (int k = 0; k < tracker.options().max_misses + 1; ++k) {
+    EXPECT_TRUE(tracker.update(R, {}).empty());
+    EXPECT_TRUE(all_tracks_finite(tracker));
+  }
+  EXPECT_TRUE(tracker.tracks().empty());
+
+  // A fresh tracker fed only garbage stays empty.
+  VpTracker fresh;
+  fresh.update(R, {Eigen::Vector3d(nan, nan, nan), Eigen::Vector3d::Zero()});
+  fresh.update(with_nan, good);
+  EXPECT_TRUE(fresh.tracks().empty());
+  EXPECT_EQ(fresh.find(0), nullptr);
+}
+
+TEST(VpTracker, ResetClearsTracksButIdsKeepIncreasing) {
+  std::mt19937 rng(7);
+  VpTracker tracker;
+  const std::vector<int> first = observe(&tracker, 0, kManhattan, 0.3, &rng);
+  EXPECT_EQ(std::set<int>(first.begin(), first.end()), (std::set<int>{0, 1, 2}));
+  tracker.reset();
+  EXPECT_TRUE(tracker.tracks().empty());
+  const std::vector<int> second = observe(&tracker, 0, kManhattan, 0.3, &rng);
+  EXPECT_EQ(std::set<int>(second.begin(), second.end()), (std::set<int>{3, 4, 5}));
+  EXPECT_EQ(tracker.tracks().size(), 3u);
+  for (const VpTrack& t : tracker.tracks()) EXPECT_EQ(t.hits, 1);
+}
+
+TEST(VpTracker, OneObservationPerTrackAndNoDuplicateTracks) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d a = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d a1 = rotation_about(Eigen::Vector3d::UnitX(), 1.0 * kDeg) * a;
+  const Eigen::Vector3d a2 = rotation_about(Eigen::Vector3d::UnitY(), -1.5 * kDeg) * a;
+  VpTracker tracker;
+  // Two detections of one VP in a new frame: the heavier starts the track, the other is a
+  // duplicate and starts none.
+  EXPECT_EQ(tracker.update(I, {a1, a}, {1.0, 2.0}), (std::vector<int>{-1, 0}));
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  // Next frame: the closer detection joins the track, the other neither joins nor starts one.
+  EXPECT_EQ(tracker.update(I, {a2, a1}), (std::vector<int>{-1, 0}));
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  EXPECT_EQ(tracker.tracks()[0].hits, 2);
+  // Detections far apart never merge.
+  EXPECT_EQ(tracker.update(I, {a, -Eigen::Vector3d::UnitX()}), (std::vector<int>{0, 1}));
+}
+
+TEST(VpTracker, DirectionIsTheSignAlignedWeightedMean) {
+  VpTrackerOptions options;
+  options.memory = 1.0;
+  VpTracker tracker(options);
+  const Eigen::Matrix3d R = rotation_about(Eigen::Vector3d(0, 1, 1).normalized(), 0.7);
+  const Eigen::Vector3d a = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  const Eigen::Vector3d b = rotation_about(a.unitOrthogonal(), 1.0 * kDeg) * a;
+  tracker.update(R, {R.transpose() * a}, {1.0});
+  tracker.update(R, {-5.0 * R.transpose() * b}, {3.0});  // other sign and scale
+  const VpTrack& t = tracker.tracks().at(0);
+  EXPECT_LT((t.direction - (a + 3.0 * b).normalized()).norm(), 1e-12);  // keeps the first sign
+  EXPECT_DOUBLE_EQ(t.weight, 4.0);
+  EXPECT_NEAR(t.last_angle_deg, 1.0, 1e-9);
+}
+
+TEST(VpTracker, FollowsSlowDriftOfTheOdometryFrame) {
+  // The odometry frame drifts 0.02 degrees per frame against the scene (a plausible rotational
+  // drift of frame-to-frame VO): the tracks must follow, which a mean over all frames would not.
+  std::mt19937 rng(8);
+  VpTracker tracker;
+  const Eigen::Vector3d drift_axis = Eigen::Vector3d(1, -2, 0.5).normalized();
+  std::vector<int> ids0;
+  for (int k = 0; k < 200; ++k) {
+    const Eigen::Matrix3d drift = rotation_about(drift_axis, 0.02 * k * kDeg);
+    const Eigen::Matrix3d R_true = camera_to_world(k);
+    std::vector<Eigen::Vector3d> directions;
+    for (const auto& axis : kManhattan)
+      directions.push_back(detect(R_true.transpose() * axis, 0.3, &rng));
+    const std::vector<int> ids = tracker.update(drift * R_true, directions);
+    if (k == 0) ids0 = ids;
+    ASSERT_EQ(ids, ids0) << "frame " << k;
+    if (k == 199) {
+      for (int a = 0; a < 3; ++a)
+        EXPECT_LT(angle_deg(tracker.find(ids0[a])->direction, drift * kManhattan[a]), 0.35) << a;
+    }
+  }
+}
+
+TEST(VpTracker, CapOnTheNumberOfTracks) {
+  VpTrackerOptions options;
+  options.max_tracks = 2;
+  VpTracker tracker(options);
+  const std::vector<int> ids =
+      tracker.update(Eigen::Matrix3d::Identity(), kManhattan, {1.0, 3.0, 2.0});
+  EXPECT_EQ(ids, (std::vector<int>{-1, 0, 1}));  // heaviest first
+  EXPECT_EQ(tracker.tracks().size(), 2u);
+}
+
+}  // namespace
+}  // namespace hybrid_vo
