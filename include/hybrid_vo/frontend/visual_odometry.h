@@ -1,0 +1,132 @@
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "hybrid_vo/frontend/frontend.h"
+#include "hybrid_vo/frontend/klt_tracker.h"
+#include "hybrid_vo/frontend/stereo.h"
+#include "hybrid_vo/lines/two_view.h"
+#include "hybrid_vo/lines/vp_tracker.h"
+
+namespace hybrid_vo {
+
+enum class PointFeatureSource {
+  kTracking,     // KLT tracks across video frames (default)
+  kDescriptors,  // SIFT/ORB matched against the keyframe
+};
+
+struct VisualOdometryOptions {
+  VisualOdometryOptions();  // the video presets of the front end (ORB, FLD)
+
+  PointFeatureSource point_source = PointFeatureSource::kTracking;
+  bool use_lines = true;
+  FrontendOptions features;   // descriptors for points (kDescriptors) and segments
+  KltTrackerOptions klt;
+  TwoViewOptions estimator;   // preset "hybrid", VPs detected jointly from the segments
+  // Frames whose median point motion to the keyframe is below this are not estimated: the
+  // epipolar geometry of a tiny baseline is noise. The keyframe stays.
+  double min_parallax_px = 2.0;
+  int min_point_matches = 8;  // below this and without enough segments the pair is hopeless
+  int min_line_matches = 12;
+  double mono_scale = 1.0;    // length given to a unit translation without stereo
+  StereoOptions stereo;
+  bool use_vp_tracker = true;
+  VpTrackerOptions vp_tracker;
+  // Weight of a VP residual in the final refinement when the tracker feeds the VPs (1: one radian
+  // counts as f pixels); tracked directions are averaged, hence more than one point's worth.
+  double tracked_vp_weight = 3.0;
+};
+
+// Externally detected features of a frame (e.g. from a learned front end); ids link them across
+// frames. Each modality present replaces the built-in one.
+struct ExternalFeatures {
+  bool has_points = false;
+  std::vector<Eigen::Vector2d> points;  // pixels
+  std::vector<int64_t> point_ids;
+  bool points_undistorted = false;      // e.g. VINS-Mono publishes undistorted coordinates
+  bool has_lines = false;
+  std::vector<LineSegment> lines;
+  std::vector<int64_t> line_ids;
+  bool lines_undistorted = false;
+};
+
+struct VisualOdometryInput {
+  double stamp = 0.0;
+  cv::Mat image;                // left or mono, 8-bit
+  CameraModel camera;
+  cv::Mat right_image;          // rectified stereo partner, optional
+  double baseline_m = 0.0;      // stereo baseline; > 0 with a right image gives metric scale
+  ExternalFeatures external;
+};
+
+enum class VoStatus {
+  kFirstFrame,      // initialised the keyframe, no motion yet
+  kOk,              // motion estimated and integrated
+  kLowParallax,     // too little motion to the keyframe; skipped
+  kTooFewFeatures,  // re-initialised on this frame, no motion
+  kNoPose,          // the estimator found no trustworthy pose; keyframe kept, no motion
+  kInvalidInput,    // empty image, invalid camera; frame ignored
+  kReset,           // time went backwards: state cleared, this frame is the new first frame
+};
+const char* to_string(VoStatus status);
+
+struct VisualOdometryResult {
+  VoStatus status = VoStatus::kInvalidInput;
+  std::string message;
+  double reference_stamp = 0.0;  // the keyframe the frame was paired with
+  TwoViewEstimate estimate;
+  RelativePose motion;           // X_cur = R X_ref + t, t scaled (metric when scale_known)
+  bool scale_known = false;
+  Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
+  TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
+  std::vector<int> vp_track_ids; // per VP match of the pair: its track, or -1
+  int num_point_matches = 0, num_line_matches = 0;
+  double frontend_ms = 0.0, estimator_ms = 0.0, total_ms = 0.0;
+};
+
+// Frame-to-frame visual odometry without ROS: front end (KLT or descriptors for points, LSD+LBD
+// for segments), the hybrid estimator against the last keyframe, stereo scale, the VP tracker,
+// and pose integration. The node only converts messages around it.
+class VisualOdometry {
+ public:
+  explicit VisualOdometry(const VisualOdometryOptions& options = {});
+  VisualOdometryResult process(const VisualOdometryInput& input);
+  void reset();
+  const VpTracker& vp_tracker() const { return vp_tracker_; }
+  const VisualOdometryOptions& options() const { return options_; }
+
+ private:
+  struct Keyframe {
+    bool valid = false;
+    double stamp = 0.0;
+    std::map<int64_t, Eigen::Vector2d> points;          // id -> distorted pixel
+    std::map<int64_t, Eigen::Vector3d> points3d;        // id -> stereo point (metres, camera)
+    ImageFeatures features;                             // segments (and descriptor points)
+    std::map<int64_t, LineSegment> external_lines;      // id -> segment
+    bool points_undistorted = false, lines_undistorted = false;
+    CameraModel camera;
+    Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  };
+
+  void make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
+                     const std::map<int64_t, Eigen::Vector2d>& points, ImageFeatures features);
+
+  VisualOdometryOptions options_;
+  KltTracker klt_;
+  VpTracker vp_tracker_;
+  Keyframe keyframe_;
+  Eigen::Matrix3d R_wc_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  double last_stamp_ = -1e300;
+  bool tracker_seeded_ = false;
+};
+
+}  // namespace hybrid_vo

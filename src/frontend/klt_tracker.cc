@@ -1,0 +1,106 @@
+#include "hybrid_vo/frontend/klt_tracker.h"
+
+#include <algorithm>
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+namespace hybrid_vo {
+namespace {
+
+cv::Mat to_gray(const cv::Mat& image) {
+  cv::Mat gray;
+  if (image.channels() == 3)
+    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4)
+    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
+  else
+    gray = image;
+  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
+  return gray;
+}
+
+}  // namespace
+
+KltTracker::KltTracker(const KltTrackerOptions& options) : options_(options) {}
+
+void KltTracker::reset() {
+  previous_.release();
+  points_.clear();
+  ids_.clear();
+}
+
+int KltTracker::num_tracks() const { return static_cast<int>(points_.size()); }
+
+std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int64_t>* ids) {
+  std::vector<PointMatch> matches;
+  if (ids) ids->clear();
+  if (image.empty()) return matches;
+  const cv::Mat gray = to_gray(image);
+  if (!previous_.empty() && previous_.size() != gray.size()) reset();
+
+  if (!previous_.empty() && !points_.empty()) {
+    std::vector<cv::Point2f> next, back;
+    std::vector<uchar> status, back_status;
+    std::vector<float> error;
+    const cv::Size window(options_.window_px, options_.window_px);
+    cv::calcOpticalFlowPyrLK(previous_, gray, points_, next, status, error, window,
+                             options_.pyramid_levels);
+    // Forward-backward consistency (Kalal et al. 2010) rejects drifting and occluded tracks.
+    cv::calcOpticalFlowPyrLK(gray, previous_, next, back, back_status, error, window,
+                             options_.pyramid_levels);
+    std::vector<cv::Point2f> kept;
+    std::vector<int64_t> kept_ids;
+    const cv::Rect2f bounds(0.0f, 0.0f, gray.cols - 1.0f, gray.rows - 1.0f);
+    const double max_fb_sq = options_.max_forward_backward_px * options_.max_forward_backward_px;
+    for (size_t i = 0; i < points_.size(); ++i) {
+      if (!status[i] || !back_status[i] || !bounds.contains(next[i])) continue;
+      const cv::Point2f d = back[i] - points_[i];
+      if (d.dot(d) > max_fb_sq) continue;
+      PointMatch m;
+      m.x1 = Eigen::Vector2d(points_[i].x, points_[i].y);
+      m.x2 = Eigen::Vector2d(next[i].x, next[i].y);
+      matches.push_back(m);
+      if (ids) ids->push_back(ids_[i]);
+      kept.push_back(next[i]);
+      kept_ids.push_back(ids_[i]);
+    }
+    points_ = std::move(kept);
+    ids_ = std::move(kept_ids);
+  }
+
+  // Re-detection by buckets keeps features spread over the image (a cluster of tracks on one
+  // textured object makes a poorly conditioned relative pose).
+  const int cells = std::max(1, options_.grid_cols * options_.grid_rows);
+  const int quota = std::max(1, options_.max_features / cells);
+  const int cell_w = (gray.cols + options_.grid_cols - 1) / std::max(1, options_.grid_cols);
+  const int cell_h = (gray.rows + options_.grid_rows - 1) / std::max(1, options_.grid_rows);
+  std::vector<int> count(cells, 0);
+  cv::Mat mask(gray.size(), CV_8U, cv::Scalar(255));
+  for (const cv::Point2f& p : points_) {
+    const int cx = std::min(options_.grid_cols - 1, static_cast<int>(p.x) / cell_w);
+    const int cy = std::min(options_.grid_rows - 1, static_cast<int>(p.y) / cell_h);
+    ++count[cy * options_.grid_cols + cx];
+    cv::circle(mask, p, static_cast<int>(options_.min_distance_px), cv::Scalar(0), cv::FILLED);
+  }
+  for (int cy = 0; cy < options_.grid_rows; ++cy) {
+    for (int cx = 0; cx < options_.grid_cols; ++cx) {
+      const int missing = quota - count[cy * options_.grid_cols + cx];
+      if (missing <= 0) continue;
+      const cv::Rect cell = cv::Rect(cx * cell_w, cy * cell_h, cell_w, cell_h) &
+                            cv::Rect(0, 0, gray.cols, gray.rows);
+      if (cell.width < 8 || cell.height < 8) continue;
+      std::vector<cv::Point2f> corners;
+      cv::goodFeaturesToTrack(gray(cell), corners, missing, options_.quality_level,
+                              options_.min_distance_px, mask(cell));
+      for (const cv::Point2f& c : corners) {
+        points_.push_back(c + cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y)));
+        ids_.push_back(next_id_++);
+      }
+    }
+  }
+  previous_ = gray.clone();
+  return matches;
+}
+
+}  // namespace hybrid_vo

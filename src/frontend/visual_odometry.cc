@@ -1,0 +1,308 @@
+#include "hybrid_vo/frontend/visual_odometry.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "hybrid_vo/geometry/rotation.h"
+
+namespace hybrid_vo {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+cv::Mat to_gray(const cv::Mat& image) {
+  cv::Mat gray;
+  if (image.channels() == 3)
+    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4)
+    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
+  else
+    gray = image;
+  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
+  return gray;
+}
+
+bool uses_vps(const RelativePoseEstimatorOptions& options) {
+  for (const SolverInfo& info : solver_table())
+    if (options.ransac.enabled[static_cast<int>(info.id)] && info.num_vps > 0) return true;
+  return false;
+}
+
+}  // namespace
+
+VisualOdometryOptions::VisualOdometryOptions() {
+  features.points = video_point_matching_options();
+  features.lines = video_line_matching_options();
+}
+
+const char* to_string(VoStatus status) {
+  switch (status) {
+    case VoStatus::kFirstFrame:
+      return "first frame";
+    case VoStatus::kOk:
+      return "ok";
+    case VoStatus::kLowParallax:
+      return "low parallax";
+    case VoStatus::kTooFewFeatures:
+      return "too few features";
+    case VoStatus::kNoPose:
+      return "no pose";
+    case VoStatus::kInvalidInput:
+      return "invalid input";
+    case VoStatus::kReset:
+      return "reset";
+  }
+  return "unknown";
+}
+
+VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
+    : options_(options), klt_(options.klt), vp_tracker_(options.vp_tracker) {
+  if (options_.use_vp_tracker) {
+    // The tracker feeds d1 from directions averaged over many frames: trust them as given (they
+    // pin the rotation to the tracked Manhattan frame, which stops rotational drift) rather than
+    // re-fitting each VP to this pair's segments.
+    options_.estimator.estimator.refinement.refine_vp_directions = false;
+    options_.estimator.estimator.refinement.vp_weight = options_.tracked_vp_weight;
+  }
+}
+
+void VisualOdometry::reset() {
+  klt_.reset();
+  vp_tracker_.reset();
+  keyframe_ = Keyframe();
+  R_wc_.setIdentity();
+  centre_.setZero();
+  last_stamp_ = -1e300;
+  tracker_seeded_ = false;
+}
+
+void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
+                                   const std::map<int64_t, Eigen::Vector2d>& points,
+                                   ImageFeatures features) {
+  keyframe_ = Keyframe();
+  keyframe_.valid = true;
+  keyframe_.stamp = input.stamp;
+  keyframe_.points = points;
+  keyframe_.features = std::move(features);
+  keyframe_.camera = input.camera;
+  keyframe_.R_wc = R_wc_;
+  keyframe_.centre = centre_;
+  if (input.external.has_lines)
+    for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i)
+      keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];
+  keyframe_.points_undistorted = input.external.has_points && input.external.points_undistorted;
+  keyframe_.lines_undistorted = input.external.has_lines && input.external.lines_undistorted;
+  // Stereo: metric 3D points of the keyframe's features, for the scale of the next motion.
+  if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
+    std::vector<int64_t> ids;
+    std::vector<Eigen::Vector2d> pixels;
+    for (const auto& [id, p] : points) {
+      ids.push_back(id);
+      pixels.push_back(p);
+    }
+    std::vector<char> valid;
+    const std::vector<Eigen::Vector3d> X = stereo_points(
+        gray, to_gray(input.right_image), pixels, input.camera.pinhole, input.baseline_m, &valid,
+        options_.stereo);
+    for (size_t i = 0; i < ids.size(); ++i)
+      if (valid[i]) keyframe_.points3d[ids[i]] = X[i];
+  }
+}
+
+VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
+  const auto start = std::chrono::steady_clock::now();
+  VisualOdometryResult r;
+  r.R_wc = R_wc_;
+  r.centre = centre_;
+  if (input.image.empty() || !input.camera.valid() || !std::isfinite(input.stamp)) {
+    r.status = VoStatus::kInvalidInput;
+    r.message = input.image.empty() ? "empty image" : "invalid camera or stamp";
+    return r;
+  }
+  bool was_reset = false;
+  if (input.stamp < last_stamp_) {
+    reset();
+    was_reset = true;
+  }
+  last_stamp_ = input.stamp;
+  const cv::Mat gray = to_gray(input.image);
+
+  // Features of this frame.
+  std::map<int64_t, Eigen::Vector2d> points;
+  ImageFeatures features;
+  if (input.external.has_points) {
+    for (size_t i = 0; i < input.external.points.size() && i < input.external.point_ids.size(); ++i)
+      if (all_finite(input.external.points[i]))
+        points[input.external.point_ids[i]] = input.external.points[i];
+  } else if (options_.point_source == PointFeatureSource::kTracking) {
+    klt_.track(gray);
+    for (size_t i = 0; i < klt_.points().size(); ++i)
+      points[klt_.ids()[i]] = Eigen::Vector2d(klt_.points()[i].x, klt_.points()[i].y);
+  } else {
+    features.points = detect_point_features(gray, options_.features.points);
+    for (size_t i = 0; i < features.points.keypoints.size(); ++i)
+      points[static_cast<int64_t>(i)] = Eigen::Vector2d(features.points.keypoints[i].pt.x,
+                                                        features.points.keypoints[i].pt.y);
+  }
+  if (options_.use_lines && !input.external.has_lines)
+    features.lines = detect_line_features(gray, options_.features.lines);
+
+  if (!keyframe_.valid) {
+    make_keyframe(input, gray, points, std::move(features));
+    r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
+    r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
+    r.reference_stamp = input.stamp;
+    r.frontend_ms = r.total_ms = ms_since(start);
+    return r;
+  }
+  r.reference_stamp = keyframe_.stamp;
+
+  // Matches keyframe -> current frame.
+  TwoViewMatches& m = r.matches;
+  std::vector<int64_t> point_ids;
+  if (!input.external.has_points && options_.point_source == PointFeatureSource::kDescriptors) {
+    std::vector<std::pair<int, int>> pairs;
+    m.points = match_point_features(keyframe_.features.points, features.points,
+                                    options_.features.points, &pairs);
+    for (const auto& p : pairs) point_ids.push_back(p.first);
+  } else {
+    for (const auto& [id, p] : points) {
+      const auto it = keyframe_.points.find(id);
+      if (it == keyframe_.points.end()) continue;
+      m.points.push_back({it->second, p});
+      point_ids.push_back(id);
+    }
+  }
+  if (input.external.has_lines) {
+    for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i) {
+      const auto it = keyframe_.external_lines.find(input.external.line_ids[i]);
+      if (it != keyframe_.external_lines.end()) m.lines.push_back({it->second, input.external.lines[i]});
+    }
+  } else if (options_.use_lines) {
+    m.lines = match_line_features(keyframe_.features.lines, features.lines, options_.features.lines);
+  }
+  r.num_point_matches = static_cast<int>(m.points.size());
+  r.num_line_matches = static_cast<int>(m.lines.size());
+  r.frontend_ms = ms_since(start);
+
+  if (r.num_point_matches < options_.min_point_matches &&
+      r.num_line_matches < options_.min_line_matches) {
+    make_keyframe(input, gray, points, std::move(features));
+    r.status = VoStatus::kTooFewFeatures;
+    r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
+                std::to_string(r.num_line_matches) + " segments): re-initialised";
+    r.total_ms = ms_since(start);
+    return r;
+  }
+  if (r.num_point_matches >= 5) {
+    std::vector<double> motion;
+    for (const PointMatch& p : m.points) motion.push_back((p.x2 - p.x1).norm());
+    std::nth_element(motion.begin(), motion.begin() + motion.size() / 2, motion.end());
+    if (motion[motion.size() / 2] < options_.min_parallax_px) {
+      r.status = VoStatus::kLowParallax;
+      r.message = "median motion " + std::to_string(motion[motion.size() / 2]) + " px";
+      r.total_ms = ms_since(start);
+      return r;
+    }
+  }
+
+  // Estimation: VPs detected jointly, refined by the tracker, then the hybrid RANSAC.
+  const auto estimate_start = std::chrono::steady_clock::now();
+  // Undistort what is still distorted (external features may come undistorted already).
+  const bool points_done = input.external.has_points && input.external.points_undistorted &&
+                           keyframe_.points_undistorted;
+  const bool lines_done = input.external.has_lines && input.external.lines_undistorted &&
+                          keyframe_.lines_undistorted;
+  {
+    TwoViewMatches distorted;
+    if (!points_done) std::swap(distorted.points, m.points);
+    if (!lines_done) std::swap(distorted.lines, m.lines);
+    undistort_matches(keyframe_.camera, input.camera, &distorted);
+    if (!points_done) std::swap(distorted.points, m.points);
+    if (!lines_done) std::swap(distorted.lines, m.lines);
+  }
+  TwoViewOptions estimator = options_.estimator;
+  if (uses_vps(estimator.estimator) && !m.lines.empty()) {
+    VpDetectionOptions vp_options = estimator.vp_detection;
+    const MatchedVps vps = estimator.joint_vp_detection
+                               ? detect_vanishing_points_joint(keyframe_.camera.pinhole,
+                                                               input.camera.pinhole, m.lines,
+                                                               vp_options)
+                               : detect_vanishing_points_standard(keyframe_.camera.pinhole,
+                                                                  input.camera.pinhole, m.lines,
+                                                                  vp_options);
+    m.vps = vps.matches;
+    m.line_vp = vps.labels;
+    if (options_.use_vp_tracker) {
+      if (!tracker_seeded_) {
+        std::vector<Eigen::Vector3d> d1;
+        for (const VpMatch& v : m.vps) d1.push_back(v.d1);
+        vp_tracker_.update(keyframe_.R_wc, d1);
+        tracker_seeded_ = true;
+      }
+      r.vp_track_ids = vp_tracker_.refine_matches(keyframe_.R_wc, &m.vps);
+    }
+  }
+  estimator.detect_vps = false;  // detected above (or unwanted)
+  r.estimate = estimate_two_view(keyframe_.camera.pinhole, input.camera.pinhole, m, estimator);
+  r.estimate.vps.matches = m.vps;
+  r.estimate.vps.labels = m.line_vp;
+  r.estimator_ms = ms_since(estimate_start);
+  const RelativePoseEstimate& est = r.estimate.estimate;
+  if (est.status != EstimationStatus::kOk) {
+    r.status = VoStatus::kNoPose;
+    r.message = std::string("estimator: ") + hybrid_vo::to_string(est.status);
+    r.total_ms = ms_since(start);
+    return r;
+  }
+
+  // Scale: stereo points of the keyframe seen again, else the configured length.
+  r.motion = est.pose;
+  double scale = options_.mono_scale;
+  if (!keyframe_.points3d.empty()) {
+    std::vector<Eigen::Vector3d> X;
+    std::vector<Eigen::Vector2d> x;
+    for (size_t i = 0; i < m.points.size() && i < point_ids.size(); ++i) {
+      if (i >= est.point_inliers.size() || !est.point_inliers[i]) continue;
+      const auto it = keyframe_.points3d.find(point_ids[i]);
+      if (it == keyframe_.points3d.end()) continue;
+      X.push_back(it->second);
+      x.push_back(input.camera.pinhole.normalize(m.points[i].x2));
+    }
+    double metric = 0.0;
+    if (scale_from_points(est.pose, X, x, &metric)) {
+      scale = metric;
+      r.scale_known = true;
+    }
+  }
+  r.motion.t = est.pose.t * scale;
+
+  // Integrate: the current camera's centre in the keyframe is -R^T t.
+  R_wc_ = nearest_rotation(keyframe_.R_wc * r.motion.R.transpose());
+  centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
+  r.R_wc = R_wc_;
+  r.centre = centre_;
+  if (options_.use_vp_tracker && !m.vps.empty()) {
+    std::vector<Eigen::Vector3d> d2;
+    std::vector<double> weights;
+    for (size_t k = 0; k < m.vps.size(); ++k) {
+      if (k < est.vp_inliers.size() && !est.vp_inliers[k]) continue;
+      d2.push_back(m.vps[k].d2);
+      weights.push_back(1.0);
+    }
+    vp_tracker_.update(R_wc_, d2, weights);
+  }
+  make_keyframe(input, gray, points, std::move(features));
+  r.status = VoStatus::kOk;
+  r.message = "ok";
+  r.total_ms = ms_since(start);
+  return r;
+}
+
+}  // namespace hybrid_vo

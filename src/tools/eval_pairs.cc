@@ -1,0 +1,361 @@
+// hybrid_vo_eval_pairs: the paper's real-data protocol on image pairs with ground truth. Every
+// method sees identical features per pair; the table has one row per method.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "datasets/readers.h"
+#include "hybrid_vo/frontend/frontend.h"
+#include "hybrid_vo/geometry/pose_error.h"
+#include "hybrid_vo/lines/two_view.h"
+#include "tool_args.h"
+
+namespace hybrid_vo {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+constexpr double kFailed = 180.0;
+
+struct Arguments {
+  std::string format, path, images;
+  int gap = 1;
+  double resize = 1.0;
+  std::vector<std::string> presets = preset_names();
+  bool opencv = true;
+  bool vp_modes = false;
+  std::string csv;
+  int max_pairs = 0;
+  uint64_t seed = 0;
+  FrontendOptions frontend;
+};
+
+void usage(const char* program) {
+  std::cerr
+      << "Usage: " << program << " --format {kitti,tum,strecha,superglue} PATH\n"
+      << "         [--images DIR] [--gap K] [--resize S] [--presets a,b,...] [--csv FILE]\n"
+      << "         [--vp-modes] [--max-pairs N] [--points sift|orb] [--lines lsd|fld] [--seed S]\n"
+      << "  Pairs are frames i and i+K (superglue: the pairs file, images under --images).\n"
+      << "  Prints method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms (AUC in %),\n"
+      << "  one row per preset plus opencv_usac_magsac (findEssentialMat + recoverPose on the same\n"
+      << "  points). --vp-modes adds the VP ablation: standard, joint, joint+refined.\n";
+}
+
+bool parse(int argc, char** argv, Arguments* a) {
+  std::vector<std::string> positional;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      usage(argv[0]);
+      std::exit(0);
+    }
+    if (arg == "--vp-modes") {
+      a->vp_modes = true;
+      continue;
+    }
+    if (arg.rfind("--", 0) != 0) {
+      positional.push_back(arg);
+      continue;
+    }
+    if (i + 1 >= argc) return std::cerr << "error: " << arg << " needs a value\n", false;
+    const std::string v = argv[++i];
+    char* end = nullptr;
+    if (arg == "--format") {
+      a->format = v;
+    } else if (arg == "--images") {
+      a->images = v;
+    } else if (arg == "--gap") {
+      a->gap = static_cast<int>(std::strtol(v.c_str(), &end, 10));
+      if (*end || a->gap < 1) return std::cerr << "error: --gap must be >= 1\n", false;
+    } else if (arg == "--resize") {
+      a->resize = std::strtod(v.c_str(), &end);
+      if (*end || !(a->resize > 0.0 && a->resize <= 4.0))
+        return std::cerr << "error: --resize must be in (0, 4]\n", false;
+    } else if (arg == "--presets") {
+      a->presets.clear();
+      a->opencv = false;
+      for (const std::string& p : tools::split_list(v)) {
+        RelativePoseEstimatorOptions unused;
+        if (p == "opencv_usac_magsac") a->opencv = true;
+        else if (preset_options(p, &unused)) a->presets.push_back(p);
+        else return std::cerr << "error: unknown method '" << p << "'\n", false;
+      }
+    } else if (arg == "--csv") {
+      a->csv = v;
+    } else if (arg == "--max-pairs") {
+      a->max_pairs = static_cast<int>(std::strtol(v.c_str(), &end, 10));
+      if (*end || a->max_pairs < 0) return std::cerr << "error: bad --max-pairs\n", false;
+    } else if (arg == "--seed") {
+      a->seed = std::strtoull(v.c_str(), &end, 10);
+    } else if (arg == "--points") {
+      if (v == "orb") a->frontend.points.type = PointFeatureType::kOrb;
+      else if (v != "sift") return std::cerr << "error: --points must be sift or orb\n", false;
+    } else if (arg == "--lines") {
+      if (v == "fld") a->frontend.lines.detection.detector = LineDetector::kFld;
+      else if (v != "lsd") return std::cerr << "error: --lines must be lsd or fld\n", false;
+    } else {
+      std::cerr << "error: unknown option " << arg << "\n";
+      return false;
+    }
+  }
+  if (positional.size() != 1 || a->format.empty()) return usage(argv[0]), false;
+  a->path = positional[0];
+  return true;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+struct MethodStats {
+  std::vector<double> errors, estimator_ms;
+};
+
+// Feature extraction, once per image (consecutive pairs share images).
+class FeatureCache {
+ public:
+  FeatureCache(const Arguments& args) : args_(args) {}
+  const ImageFeatures* get(const std::string& path, double* ms, cv::Mat* image_out) {
+    auto it = cache_.find(path);
+    if (it == cache_.end()) {
+      cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE);
+      if (image.empty()) return nullptr;
+      if (args_.resize != 1.0)
+        cv::resize(image, image, cv::Size(), args_.resize, args_.resize, cv::INTER_AREA);
+      Entry e;
+      const auto start = std::chrono::steady_clock::now();
+      e.features = extract_features(image, args_.frontend);
+      e.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                 .count();
+      e.image = image;
+      if (cache_.size() > 4) cache_.erase(cache_.begin());
+      it = cache_.emplace(path, std::move(e)).first;
+    }
+    *ms = it->second.ms;
+    if (image_out) *image_out = it->second.image;
+    return &it->second.features;
+  }
+
+ private:
+  struct Entry {
+    ImageFeatures features;
+    cv::Mat image;
+    double ms = 0.0;
+  };
+  const Arguments& args_;
+  std::map<std::string, Entry> cache_;
+};
+
+// OpenCV's USAC_MAGSAC essential matrix plus recoverPose, on normalised points when the two
+// cameras differ (its API takes one K).
+double run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const PinholeCamera& c2,
+                  const RelativePose& truth, double* ms) {
+  const auto start = std::chrono::steady_clock::now();
+  double error = kFailed;
+  if (m.points.size() >= 5) {
+    std::vector<cv::Point2d> p1, p2;
+    for (const PointMatch& p : m.points) {
+      const Eigen::Vector2d a = c1.normalize(p.x1), b = c2.normalize(p.x2);
+      p1.emplace_back(a.x(), a.y());
+      p2.emplace_back(b.x(), b.y());
+    }
+    const double f = 0.5 * (c1.mean_focal() + c2.mean_focal());
+    cv::Mat mask;
+    const cv::Mat E = cv::findEssentialMat(p1, p2, cv::Mat::eye(3, 3, CV_64F), cv::USAC_MAGSAC,
+                                           0.999, 1.0 / f, mask);
+    if (E.rows == 3 && E.cols == 3) {
+      cv::Mat R, t;
+      if (cv::recoverPose(E, p1, p2, cv::Mat::eye(3, 3, CV_64F), R, t, mask) > 0) {
+        Eigen::Matrix3d Re;
+        Eigen::Vector3d te;
+        for (int r = 0; r < 3; ++r) {
+          te(r) = t.at<double>(r);
+          for (int k = 0; k < 3; ++k) Re(r, k) = R.at<double>(r, k);
+        }
+        error = pose_error(RelativePose(Re, te), truth) * kDeg;
+      }
+    }
+  }
+  *ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return error;
+}
+
+void print_row(const std::string& method, const MethodStats& s, double frontend_ms) {
+  std::printf("%s,%.2f,%.2f,%.2f,%.3f,%.2f,%.2f\n", method.c_str(), 100.0 * pose_auc(s.errors, 5.0),
+              100.0 * pose_auc(s.errors, 10.0), 100.0 * pose_auc(s.errors, 20.0),
+              median(s.errors), median(s.estimator_ms), frontend_ms);
+}
+
+}  // namespace
+}  // namespace hybrid_vo
+
+int main(int argc, char** argv) {
+  using namespace hybrid_vo;
+  Arguments args;
+  if (!parse(argc, argv, &args)) return 2;
+  cv::setNumThreads(1);
+
+  std::vector<datasets::PairWithGt> pairs;
+  std::string error;
+  if (args.format == "superglue") {
+    if (!datasets::read_superglue(args.path, args.images, &pairs, &error)) {
+      std::cerr << "error: " << error << "\n";
+      return 1;
+    }
+  } else if (args.format == "kitti" || args.format == "tum" || args.format == "strecha") {
+    datasets::Sequence sequence;
+    if (!datasets::read_sequence(args.format, args.path, &sequence, &error)) {
+      std::cerr << "error: " << error << "\n";
+      return 1;
+    }
+    pairs = datasets::make_pairs(sequence, args.gap);
+  } else {
+    std::cerr << "error: --format must be kitti, tum, strecha or superglue\n";
+    return 2;
+  }
+  if (args.max_pairs > 0 && static_cast<int>(pairs.size()) > args.max_pairs)
+    pairs.resize(args.max_pairs);
+  if (pairs.empty()) {
+    std::cerr << "error: no pairs (too few frames for --gap " << args.gap << "?)\n";
+    return 1;
+  }
+
+  std::ofstream csv;
+  if (!args.csv.empty()) {
+    csv.open(args.csv);
+    if (!csv) {
+      std::cerr << "error: cannot write " << args.csv << "\n";
+      return 1;
+    }
+    csv << "pair,image0,image1,method,rot_err_deg,trans_err_deg,pose_err_deg,points,lines,vps,"
+           "estimator_ms\n";
+  }
+
+  FeatureCache cache(args);
+  std::map<std::string, MethodStats> stats;
+  std::vector<double> frontend_ms;
+  // VP ablation: per mode, VP matches per pair, consistent matches, and the VP solvers alone.
+  const std::vector<std::string> vp_modes = {"standard", "joint", "joint+refined"};
+  const std::vector<SolverId> vp_solvers = {SolverId::k1vp3pt, SolverId::k2vp2pt,
+                                            SolverId::k1vpOrthline2pt};
+  std::map<std::string, std::vector<double>> vp_counts, vp_consistent;
+  std::map<std::string, std::map<int, std::vector<double>>> vp_solver_errors;
+
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const datasets::PairWithGt& pair = pairs[p];
+    double ms0 = 0.0, ms1 = 0.0;
+    const ImageFeatures* f0 = cache.get(pair.image_path0, &ms0, nullptr);
+    const ImageFeatures* f1 = f0 ? cache.get(pair.image_path1, &ms1, nullptr) : nullptr;
+    if (!f0 || !f1) {
+      std::cerr << "error: cannot read " << (f0 ? pair.image_path1 : pair.image_path0) << "\n";
+      return 1;
+    }
+    const CameraModel c0 = datasets::scaled(pair.camera0, args.resize);
+    const CameraModel c1 = datasets::scaled(pair.camera1, args.resize);
+    double match_ms = 0.0;
+    const TwoViewMatches matches = match_features(*f0, *f1, c0, c1, args.frontend, &match_ms);
+    frontend_ms.push_back(ms0 + ms1 + match_ms);
+    RelativePose truth = pair.pose;
+    truth.t.normalize();
+    auto record = [&](const std::string& method, const RelativePose* pose, double ms, int vps) {
+      const double rot = pose ? rotation_error(pose->R, truth.R) * kDeg : kFailed;
+      const double trans = pose ? translation_error(pose->t, truth.t) * kDeg : kFailed;
+      stats[method].errors.push_back(std::max(rot, trans));
+      stats[method].estimator_ms.push_back(ms);
+      if (csv)
+        csv << p << ',' << pair.image_path0 << ',' << pair.image_path1 << ',' << method << ','
+            << rot << ',' << trans << ',' << std::max(rot, trans) << ',' << matches.points.size()
+            << ',' << matches.lines.size() << ',' << vps << ',' << ms << '\n';
+    };
+
+    for (const std::string& preset : args.presets) {
+      TwoViewOptions options;
+      preset_options(preset, &options.estimator);
+      options.estimator.ransac.seed = args.seed + p;
+      const auto start = std::chrono::steady_clock::now();
+      const TwoViewEstimate result =
+          estimate_two_view(c0.pinhole, c1.pinhole, matches, options);
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count();
+      const bool ok = result.estimate.status == EstimationStatus::kOk;
+      record(preset, ok ? &result.estimate.pose : nullptr, ms,
+             static_cast<int>(result.vps.matches.size()));
+    }
+    if (args.opencv) {
+      double ms = 0.0;
+      const double e = run_opencv(matches, c0.pinhole, c1.pinhole, truth, &ms);
+      stats["opencv_usac_magsac"].errors.push_back(e);
+      stats["opencv_usac_magsac"].estimator_ms.push_back(ms);
+      if (csv)
+        csv << p << ',' << pair.image_path0 << ',' << pair.image_path1 << ",opencv_usac_magsac,,,"
+            << e << ',' << matches.points.size() << ',' << matches.lines.size() << ",0," << ms
+            << '\n';
+    }
+
+    if (args.vp_modes) {
+      for (const std::string& mode : vp_modes) {
+        VpDetectionOptions vp_options;
+        vp_options.refine = mode == "joint+refined";
+        vp_options.seed = args.seed + p;
+        const MatchedVps vps =
+            mode == "standard"
+                ? detect_vanishing_points_standard(c0.pinhole, c1.pinhole, matches.lines, vp_options)
+                : detect_vanishing_points_joint(c0.pinhole, c1.pinhole, matches.lines, vp_options);
+        vp_counts[mode].push_back(vps.matches.size());
+        for (const VpMatch& v : vps.matches) {
+          const Eigen::Vector3d a = truth.R * v.d1.normalized();
+          const double angle =
+              std::acos(std::min(1.0, std::abs(a.dot(v.d2.normalized())))) * kDeg;
+          vp_consistent[mode].push_back(angle < 2.0 ? 1.0 : 0.0);
+        }
+        TwoViewMatches with_vps = matches;
+        with_vps.vps = vps.matches;
+        with_vps.line_vp = vps.labels;
+        for (SolverId id : vp_solvers) {
+          RelativePoseEstimatorOptions only;
+          only.ransac.enabled.fill(false);
+          only.ransac.enabled[static_cast<int>(id)] = true;
+          only.ransac.seed = args.seed + p;
+          const RelativePoseEstimate est =
+              estimate_relative_pose(c0.pinhole, c1.pinhole, with_vps, only);
+          vp_solver_errors[mode][static_cast<int>(id)].push_back(
+              est.status == EstimationStatus::kOk ? pose_error(est.pose, truth) * kDeg : kFailed);
+        }
+      }
+    }
+  }
+
+  std::printf("method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms\n");
+  const double fe = median(frontend_ms);
+  for (const std::string& preset : args.presets) print_row(preset, stats[preset], fe);
+  if (args.opencv) print_row("opencv_usac_magsac", stats["opencv_usac_magsac"], fe);
+  std::printf("# %zu pairs, gap %d, resize %.2f\n", pairs.size(), args.gap, args.resize);
+  if (args.vp_modes) {
+    std::printf("\nvp_mode,vp_matches_per_pair,consistent_fraction,auc10_3-0-1,auc10_2-0-2,"
+                "auc10_2-1-1p\n");
+    for (const std::string& mode : vp_modes) {
+      double count = 0.0, consistent = 0.0;
+      for (double c : vp_counts[mode]) count += c;
+      for (double c : vp_consistent[mode]) consistent += c;
+      const double consistent_fraction =
+          vp_consistent[mode].empty() ? 0.0 : consistent / vp_consistent[mode].size();
+      std::printf("%s,%.2f,%.3f", mode.c_str(), count / pairs.size(), consistent_fraction);
+      for (SolverId id : vp_solvers)
+        std::printf(",%.2f", 100.0 * pose_auc(vp_solver_errors[mode][static_cast<int>(id)], 10.0));
+      std::printf("\n");
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,257 @@
+// hybrid_vo_eval_trajectory: a recorded run (its ~relative_pose messages and /tf) against the
+// ground truth written by the renderer or a converter; or two TUM trajectory files.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <geometry_msgs/PoseStamped.h>
+#include <hybrid_vo/MotionEstimate.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include "hybrid_vo/geometry/pose_error.h"
+#include "plot.h"
+#include "trajectory.h"
+
+namespace {
+
+using hybrid_vo::tools::StampedPose;
+using hybrid_vo::tools::Trajectory;
+constexpr double kDeg = 180.0 / M_PI;
+
+void usage(const char* program) {
+  std::cerr << "Usage: " << program
+            << " --bag RUN.bag --gt GT.bag [--gt-topic /ground_truth/pose] [--plot OUT.png]\n"
+               "       " << program << " --tum EST.txt GT.txt [--plot OUT.png]\n"
+               "  Per-pair rotation and translation-direction errors with AUC@5/10/20, RPE, ATE\n"
+               "  after alignment (similarity without metric scale), KITTI-style drift, and a plot.\n"
+               "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n";
+}
+
+StampedPose from_transform(double stamp, const geometry_msgs::Transform& t) {
+  StampedPose p;
+  p.stamp = stamp;
+  p.R = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z)
+            .normalized()
+            .toRotationMatrix();
+  p.c = Eigen::Vector3d(t.translation.x, t.translation.y, t.translation.z);
+  return p;
+}
+
+struct Run {
+  Trajectory trajectory;  // camera poses in the odometry frame
+  std::vector<hybrid_vo::MotionEstimate> motions;
+  int scale_known = 0;
+};
+
+bool read_run(const std::string& path, Run* run, std::string* error) {
+  rosbag::Bag bag;
+  try {
+    bag.open(path, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    *error = path + ": " + e.what();
+    return false;
+  }
+  // odom -> child poses over time, and static transforms (e.g. base_link -> camera).
+  std::map<std::string, Trajectory> by_child;
+  std::map<std::pair<std::string, std::string>, geometry_msgs::Transform> statics;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
+    if (const auto tf = m.instantiate<tf2_msgs::TFMessage>()) {
+      for (const auto& t : tf->transforms) {
+        if (m.getTopic() == "/tf_static") statics[{t.header.frame_id, t.child_frame_id}] = t.transform;
+        else if (t.header.frame_id == "odom")
+          by_child[t.child_frame_id].push_back(from_transform(t.header.stamp.toSec(), t.transform));
+      }
+    } else if (const auto motion = m.instantiate<hybrid_vo::MotionEstimate>()) {
+      run->motions.push_back(*motion);
+      run->scale_known += motion->scale_known;
+    }
+  }
+  bag.close();
+  if (by_child.empty() && run->motions.empty()) {
+    *error = path + ": no odom transforms and no hybrid_vo/MotionEstimate messages";
+    return false;
+  }
+  if (!by_child.empty()) {
+    // The longest odom -> child track; through a static child -> camera transform when one is
+    // known, so that the poses are camera poses like the ground truth.
+    auto best = by_child.begin();
+    for (auto it = by_child.begin(); it != by_child.end(); ++it)
+      if (it->second.size() > best->second.size()) best = it;
+    const std::string child = best->first;
+    std::string camera_frame;
+    if (!run->motions.empty()) camera_frame = run->motions.front().header.frame_id;
+    const auto link = statics.find({child, camera_frame});
+    for (StampedPose p : best->second) {
+      if (link != statics.end()) {
+        const StampedPose bc = from_transform(0.0, link->second);
+        p.c = p.c + p.R * bc.c;
+        p.R = p.R * bc.R;
+      }
+      run->trajectory.push_back(p);
+    }
+    std::sort(run->trajectory.begin(), run->trajectory.end(),
+              [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+  }
+  return true;
+}
+
+bool read_gt(const std::string& path, const std::string& topic, Trajectory* gt, std::string* error) {
+  rosbag::Bag bag;
+  try {
+    bag.open(path, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    *error = path + ": " + e.what();
+    return false;
+  }
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(topic))) {
+    if (const auto pose = m.instantiate<geometry_msgs::PoseStamped>()) {
+      StampedPose p;
+      p.stamp = pose->header.stamp.toSec();
+      const auto& q = pose->pose.orientation;
+      p.R = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+      p.c = Eigen::Vector3d(pose->pose.position.x, pose->pose.position.y, pose->pose.position.z);
+      gt->push_back(p);
+    }
+  }
+  bag.close();
+  if (gt->empty()) {
+    *error = path + ": no geometry_msgs/PoseStamped on " + topic;
+    return false;
+  }
+  std::sort(gt->begin(), gt->end(),
+            [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string bag, gt_bag, gt_topic = "/ground_truth/pose", tum_est, tum_gt, plot;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto next = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << "error: " << a << " needs a value\n";
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--bag") bag = next();
+    else if (a == "--gt") gt_bag = next();
+    else if (a == "--gt-topic") gt_topic = next();
+    else if (a == "--plot") plot = next();
+    else if (a == "--tum") {
+      tum_est = next();
+      tum_gt = next();
+    } else if (a == "--help" || a == "-h") {
+      usage(argv[0]);
+      return 0;
+    } else {
+      std::cerr << "error: unknown argument '" << a << "'\n";
+      usage(argv[0]);
+      return 2;
+    }
+  }
+  Run run;
+  Trajectory gt;
+  std::string error;
+  if (!tum_est.empty()) {
+    if (!hybrid_vo::tools::read_tum_trajectory(tum_est, &run.trajectory, &error) ||
+        !hybrid_vo::tools::read_tum_trajectory(tum_gt, &gt, &error)) {
+      std::cerr << "error: " << error << "\n";
+      return 1;
+    }
+  } else if (!bag.empty() && !gt_bag.empty()) {
+    if (!read_run(bag, &run, &error) || !read_gt(gt_bag, gt_topic, &gt, &error)) {
+      std::cerr << "error: " << error << "\n";
+      return 1;
+    }
+  } else {
+    usage(argv[0]);
+    return 2;
+  }
+  const double tolerance = 1e-3;
+
+  // Per-pair errors: the node's own relative poses when recorded, else consecutive poses.
+  std::vector<double> errors;
+  int failures = 0, skipped = 0;
+  std::printf("pair,stamp_ref,stamp,status,rot_err_deg,dir_err_deg\n");
+  if (!run.motions.empty()) {
+    for (const hybrid_vo::MotionEstimate& m : run.motions) {
+      if (m.status == hybrid_vo::MotionEstimate::STATUS_SKIPPED) {
+        ++skipped;
+        continue;
+      }
+      StampedPose a, b;
+      if (!hybrid_vo::tools::pose_at(gt, m.reference_stamp.toSec(), tolerance, &a) ||
+          !hybrid_vo::tools::pose_at(gt, m.header.stamp.toSec(), tolerance, &b))
+        continue;
+      double rot = 180.0, dir = 180.0;
+      if (m.status == hybrid_vo::MotionEstimate::STATUS_OK) {
+        const auto& q = m.transform.rotation;
+        const Eigen::Matrix3d R = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
+        const Eigen::Vector3d t(m.transform.translation.x, m.transform.translation.y,
+                                m.transform.translation.z);
+        const Eigen::Matrix3d R_gt = b.R.transpose() * a.R;
+        const Eigen::Vector3d t_gt = b.R.transpose() * (a.c - b.c);
+        rot = hybrid_vo::rotation_error(R, R_gt) * kDeg;
+        dir = hybrid_vo::translation_error(t, t_gt) * kDeg;
+      } else {
+        ++failures;
+      }
+      errors.push_back(std::max(rot, dir));
+      std::printf("%zu,%.6f,%.6f,%d,%.4f,%.4f\n", errors.size() - 1, m.reference_stamp.toSec(),
+                  m.header.stamp.toSec(), m.status, rot, dir);
+    }
+  }
+  const bool with_scale = run.scale_known * 2 < static_cast<int>(run.motions.size()) || run.motions.empty();
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> aligned;
+  const hybrid_vo::tools::TrajectoryErrors te =
+      hybrid_vo::tools::compare_trajectories(run.trajectory, gt, with_scale, tolerance, &aligned);
+  if (run.motions.empty()) {
+    for (size_t i = 0; i < te.rot_err_deg.size(); ++i) {
+      errors.push_back(std::max(te.rot_err_deg[i], te.dir_err_deg[i]));
+      std::printf("%zu,,,0,%.4f,%.4f\n", i, te.rot_err_deg[i], te.dir_err_deg[i]);
+    }
+  }
+  if (!plot.empty() && !aligned.empty()) {
+    // Top-down view: the two axes along which the ground truth moves most.
+    Eigen::Vector3d lo = aligned[0].second, hi = lo;
+    for (const auto& p : aligned) lo = lo.cwiseMin(p.second), hi = hi.cwiseMax(p.second);
+    const Eigen::Vector3d extent = hi - lo;
+    int a0 = 0, a1 = 1;
+    if (extent(2) > extent(a0) && extent(2) > extent(a1)) (extent(0) < extent(1) ? a0 : a1) = 2;
+    else if (extent(2) > std::min(extent(0), extent(1))) (extent(0) < extent(1) ? a0 : a1) = 2;
+    if (a0 > a1) std::swap(a0, a1);
+    hybrid_vo::tools::PlotSeries est{"estimate (aligned)", {}, {}}, truth{"ground truth", {}, {}};
+    for (const auto& p : aligned) {
+      est.x.push_back(p.first(a0));
+      est.y.push_back(p.first(a1));
+      truth.x.push_back(p.second(a0));
+      truth.y.push_back(p.second(a1));
+    }
+    hybrid_vo::tools::PlotOptions options;
+    options.title = "Trajectory, top view";
+    options.x_label = std::string("axis ") + "xyz"[a0] + " [m]";
+    options.y_label = std::string("axis ") + "xyz"[a1] + " [m]";
+    if (!hybrid_vo::tools::write_line_plot(plot, {truth, est}, options))
+      std::cerr << "warning: cannot write " << plot << "\n";
+  }
+  std::printf("# %d failed, %d skipped frames; trajectory: %d poses compared, scale %s %.4f; "
+              "drift %.2f %% and %.3f deg/100 m over %d segments\n",
+              failures, skipped, te.pairs + 1, with_scale ? "aligned" : "metric", te.scale,
+              te.drift_trans_percent, te.drift_rot_deg_per_100m, te.drift_segments);
+  std::printf("summary: pairs=%zu auc5=%.2f auc10=%.2f auc20=%.2f rpe_trans=%.4f rpe_rot_deg=%.4f "
+              "ate=%.4f\n",
+              errors.size(), 100.0 * hybrid_vo::pose_auc(errors, 5.0),
+              100.0 * hybrid_vo::pose_auc(errors, 10.0), 100.0 * hybrid_vo::pose_auc(errors, 20.0),
+              te.rpe_trans, te.rpe_rot_deg, te.ate);
+  return 0;
+}
