@@ -1,0 +1,45 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <geometry_msgs/Transform.h>
+#include <hybrid_vo/FeatureLines.h>
+#include <hybrid_vo/FeaturePoints.h>
+#include <opencv2/core.hpp>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud.h>
+
+#include "hybrid_vo/frontend/visual_odometry.h"
+
+namespace hybrid_vo {
+
+// camera_info to the front end's camera model. False with a reason when it cannot be used: zero
+// or non-finite K, zero image size, or a distortion model other than plumb_bob /
+// rational_polynomial with up to five coefficients (more are not supported).
+bool camera_from_info(const sensor_msgs::CameraInfo& info, CameraModel* camera,
+                      std::string* reason);
+
+// Stereo baseline in metres from the right camera's projection matrix (P[3] = -fx * B).
+bool baseline_from_info(const sensor_msgs::CameraInfo& right, double* baseline);
+
+// An image as 8-bit grayscale (mono8, mono16, bgr8, rgb8, bgra8, rgba8). False with a reason for
+// an empty image or another encoding.
+bool gray_from_image(const sensor_msgs::ImageConstPtr& image, cv::Mat* gray, std::string* reason);
+
+// Feature messages to external features (pixels). Mismatched array sizes are an error.
+bool points_from_msg(const FeaturePoints& msg, ExternalFeatures* features, std::string* reason);
+bool lines_from_msg(const FeatureLines& msg, ExternalFeatures* features, std::string* reason);
+
+// The VINS-Mono / PL-VINS encodings (sensor_msgs/PointCloud with undistorted normalised
+// coordinates): points carry channels [id, u, v, ...], lines a start point and channels
+// [id, end x, end y], both normalised. Converted to undistorted pixels with the camera.
+bool points_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& camera,
+                      ExternalFeatures* features, std::string* reason);
+bool lines_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& camera,
+                     ExternalFeatures* features, std::string* reason);
+
+geometry_msgs::Transform to_transform(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+
+}  // namespace hybrid_vo

@@ -1,0 +1,141 @@
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <diagnostic_updater/update_functions.h>
+#include <hybrid_vo/FeatureLines.h>
+#include <hybrid_vo/FeaturePoints.h>
+#include <image_transport/image_transport.h>
+#include <image_transport/subscriber_filter.h>
+#include <message_filters/subscriber.h>
+#include <message_filters/sync_policies/approximate_time.h>
+#include <message_filters/sync_policies/exact_time.h>
+#include <message_filters/synchronizer.h>
+#include <nav_msgs/Path.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "hybrid_vo/frontend/visual_odometry.h"
+
+namespace hybrid_vo {
+
+// The ROS wrapper around VisualOdometry: synchronised image (+ camera_info) input, mono or stereo,
+// optional feature topics, and the outputs of DESIGN.md "The node". Usable from a node's main()
+// or from the nodelet.
+class VoNode {
+ public:
+  VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+
+ private:
+  struct Frame {
+    ros::Time stamp;
+    std::string frame_id;
+    sensor_msgs::ImageConstPtr left, right;
+    sensor_msgs::CameraInfoConstPtr left_info, right_info;
+    bool have_images = false, have_points = false, have_lines = false;
+    FeaturePoints::ConstPtr points;
+    FeatureLines::ConstPtr lines;
+    sensor_msgs::PointCloud::ConstPtr vins_points, vins_lines;
+  };
+
+  void load_parameters();
+  void subscribe();
+  void mono_callback(const sensor_msgs::ImageConstPtr& image,
+                     const sensor_msgs::CameraInfoConstPtr& info);
+  void stereo_callback(const sensor_msgs::ImageConstPtr& left,
+                       const sensor_msgs::CameraInfoConstPtr& left_info,
+                       const sensor_msgs::ImageConstPtr& right,
+                       const sensor_msgs::CameraInfoConstPtr& right_info);
+  void raw_image_callback(const sensor_msgs::ImageConstPtr& image);
+  void points_callback(const FeaturePoints::ConstPtr& msg);
+  void lines_callback(const FeatureLines::ConstPtr& msg);
+  void vins_points_callback(const sensor_msgs::PointCloud::ConstPtr& msg);
+  void vins_lines_callback(const sensor_msgs::PointCloud::ConstPtr& msg);
+  bool reset_callback(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
+  void watchdog(const ros::TimerEvent&);
+
+  // Frames wait here until every part (images, and the feature topics in use) has arrived.
+  Frame& pending(const ros::Time& stamp);
+  void try_process(const ros::Time& stamp);
+  void process(const Frame& frame);
+  void publish(const Frame& frame, const VisualOdometryInput& input,
+               const VisualOdometryResult& result);
+  void publish_pose(const ros::Time& stamp, const std::string& camera_frame,
+                    const VisualOdometryResult& result);
+  void reject(const std::string& what, const std::string& reason, int* counter);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void reset_state(const std::string& why);
+
+  ros::NodeHandle nh_, pnh_;
+  image_transport::ImageTransport it_;
+
+  // Parameters.
+  std::string odom_frame_, base_frame_;
+  bool stereo_ = false, approximate_sync_ = false, publish_tf_ = true;
+  bool use_feature_points_ = false, use_feature_lines_ = false, vins_format_ = false;
+  bool publish_debug_image_ = true, publish_markers_ = true;
+  int queue_size_ = 10;
+  double camera_info_timeout_ = 2.0;
+  VisualOdometryOptions vo_options_;
+
+  // Input.
+  using ExactMono = message_filters::sync_policies::ExactTime<sensor_msgs::Image,
+                                                              sensor_msgs::CameraInfo>;
+  using ApproxMono = message_filters::sync_policies::ApproximateTime<sensor_msgs::Image,
+                                                                     sensor_msgs::CameraInfo>;
+  using ExactStereo = message_filters::sync_policies::ExactTime<
+      sensor_msgs::Image, sensor_msgs::CameraInfo, sensor_msgs::Image, sensor_msgs::CameraInfo>;
+  using ApproxStereo = message_filters::sync_policies::ApproximateTime<
+      sensor_msgs::Image, sensor_msgs::CameraInfo, sensor_msgs::Image, sensor_msgs::CameraInfo>;
+  image_transport::SubscriberFilter left_sub_, right_sub_;
+  message_filters::Subscriber<sensor_msgs::CameraInfo> left_info_sub_, right_info_sub_;
+  std::unique_ptr<message_filters::Synchronizer<ExactMono>> exact_mono_;
+  std::unique_ptr<message_filters::Synchronizer<ApproxMono>> approx_mono_;
+  std::unique_ptr<message_filters::Synchronizer<ExactStereo>> exact_stereo_;
+  std::unique_ptr<message_filters::Synchronizer<ApproxStereo>> approx_stereo_;
+  ros::Subscriber raw_image_sub_, points_sub_, lines_sub_;
+  ros::ServiceServer reset_service_;
+  ros::Timer watchdog_timer_;
+
+  // Output.
+  ros::Publisher relative_pose_pub_, odometry_pub_, path_pub_, vps_pub_, markers_pub_;
+  image_transport::Publisher debug_image_pub_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  nav_msgs::Path path_;
+
+  // State.
+  std::mutex mutex_;
+  std::unique_ptr<VisualOdometry> vo_;
+  std::map<ros::Time, Frame> pending_;
+  ros::Time last_processed_;
+  bool have_base_transform_ = false, looked_up_base_ = false;
+  Eigen::Matrix3d R_base_camera_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t_base_camera_ = Eigen::Vector3d::Zero();
+  std::string camera_frame_;
+  ros::Time last_pose_stamp_;
+  Eigen::Vector3d last_centre_ = Eigen::Vector3d::Zero();
+
+  // Diagnostics.
+  diagnostic_updater::Updater updater_;
+  double min_frequency_ = 1.0, max_frequency_ = 100.0;
+  std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
+  ros::Time last_raw_image_, last_synced_image_;
+  VisualOdometryResult last_result_;
+  std::string last_problem_;
+  int frames_ = 0, invalid_camera_info_ = 0, bad_images_ = 0, time_jumps_ = 0, failures_ = 0,
+      dropped_ = 0, bad_features_ = 0;
+};
+
+}  // namespace hybrid_vo

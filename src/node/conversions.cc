@@ -1,0 +1,185 @@
+#include "hybrid_vo/node/conversions.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+#include <cv_bridge/cv_bridge.h>
+#include <opencv2/imgproc.hpp>
+#include <sensor_msgs/distortion_models.h>
+#include <sensor_msgs/image_encodings.h>
+
+namespace hybrid_vo {
+
+bool camera_from_info(const sensor_msgs::CameraInfo& info, CameraModel* camera,
+                      std::string* reason) {
+  CameraModel c;
+  c.pinhole = PinholeCamera(info.K[0], info.K[4], info.K[2], info.K[5], info.width, info.height);
+  if (!c.pinhole.valid() || info.width == 0 || info.height == 0) {
+    *reason = "camera_info has no valid K or image size";
+    return false;
+  }
+  const bool known_model = info.distortion_model.empty() ||
+                           info.distortion_model == sensor_msgs::distortion_models::PLUMB_BOB ||
+                           info.distortion_model ==
+                               sensor_msgs::distortion_models::RATIONAL_POLYNOMIAL;
+  if (!known_model) {
+    *reason = "unsupported distortion model '" + info.distortion_model + "'";
+    return false;
+  }
+  for (size_t k = 0; k < info.D.size(); ++k) {
+    if (!std::isfinite(info.D[k])) {
+      *reason = "camera_info has a non-finite distortion coefficient";
+      return false;
+    }
+    if (k < 5) {
+      c.distortion[k] = info.D[k];
+    } else if (info.D[k] != 0.0) {
+      *reason = "distortion with more than five coefficients is not supported";
+      return false;
+    }
+  }
+  *camera = c;
+  return true;
+}
+
+bool baseline_from_info(const sensor_msgs::CameraInfo& right, double* baseline) {
+  const double fx = right.P[0], tx = right.P[3];
+  if (!(fx > 0.0) || !std::isfinite(tx) || tx == 0.0) return false;
+  *baseline = std::abs(tx / fx);
+  return true;
+}
+
+bool gray_from_image(const sensor_msgs::ImageConstPtr& image, cv::Mat* gray, std::string* reason) {
+  namespace enc = sensor_msgs::image_encodings;
+  if (!image || image->width == 0 || image->height == 0 || image->data.empty()) {
+    *reason = "empty image";
+    return false;
+  }
+  const std::string& e = image->encoding;
+  if (e != enc::MONO8 && e != enc::MONO16 && e != enc::BGR8 && e != enc::RGB8 &&
+      e != enc::BGRA8 && e != enc::RGBA8) {
+    *reason = "unsupported encoding '" + e + "'";
+    return false;
+  }
+  try {
+    const cv_bridge::CvImageConstPtr cv = cv_bridge::toCvShare(image);
+    if (e == enc::MONO8) {
+      *gray = cv->image.clone();
+    } else if (e == enc::MONO16) {
+      cv->image.convertTo(*gray, CV_8U, 1.0 / 256.0);
+    } else if (e == enc::BGR8) {
+      cv::cvtColor(cv->image, *gray, cv::COLOR_BGR2GRAY);
+    } else if (e == enc::RGB8) {
+      cv::cvtColor(cv->image, *gray, cv::COLOR_RGB2GRAY);
+    } else if (e == enc::BGRA8) {
+      cv::cvtColor(cv->image, *gray, cv::COLOR_BGRA2GRAY);
+    } else {
+      cv::cvtColor(cv->image, *gray, cv::COLOR_RGBA2GRAY);
+    }
+  } catch (const cv_bridge::Exception& ex) {
+    *reason = std::string("cv_bridge: ") + ex.what();
+    return false;
+  }
+  return !gray->empty();
+}
+
+bool points_from_msg(const FeaturePoints& msg, ExternalFeatures* f, std::string* reason) {
+  if (msg.x.size() != msg.y.size() || msg.ids.size() != msg.x.size()) {
+    *reason = "features/points: ids, x and y differ in length";
+    return false;
+  }
+  f->has_points = true;
+  f->points_undistorted = false;
+  f->points.clear();
+  f->point_ids.clear();
+  for (size_t i = 0; i < msg.x.size(); ++i) {
+    if (!std::isfinite(msg.x[i]) || !std::isfinite(msg.y[i])) continue;
+    f->points.emplace_back(msg.x[i], msg.y[i]);
+    f->point_ids.push_back(msg.ids[i]);
+  }
+  return true;
+}
+
+bool lines_from_msg(const FeatureLines& msg, ExternalFeatures* f, std::string* reason) {
+  const size_t n = msg.ids.size();
+  if (msg.x1.size() != n || msg.y1.size() != n || msg.x2.size() != n || msg.y2.size() != n) {
+    *reason = "features/lines: ids, x1, y1, x2 and y2 differ in length";
+    return false;
+  }
+  f->has_lines = true;
+  f->lines_undistorted = false;
+  f->lines.clear();
+  f->line_ids.clear();
+  for (size_t i = 0; i < n; ++i) {
+    const LineSegment s({msg.x1[i], msg.y1[i]}, {msg.x2[i], msg.y2[i]});
+    if (!all_finite(s.p1) || !all_finite(s.p2) || !(s.length() > 0.0)) continue;
+    f->lines.push_back(s);
+    f->line_ids.push_back(msg.ids[i]);
+  }
+  return true;
+}
+
+namespace {
+
+const sensor_msgs::ChannelFloat32* channel(const sensor_msgs::PointCloud& msg, size_t index,
+                                           std::string* reason) {
+  if (msg.channels.size() <= index || msg.channels[index].values.size() != msg.points.size()) {
+    *reason = "PointCloud features: channel " + std::to_string(index) + " missing or of the wrong size";
+    return nullptr;
+  }
+  return &msg.channels[index];
+}
+
+}  // namespace
+
+bool points_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& camera,
+                      ExternalFeatures* f, std::string* reason) {
+  const sensor_msgs::ChannelFloat32* ids = channel(msg, 0, reason);
+  if (!ids) return false;
+  f->has_points = true;
+  f->points_undistorted = true;
+  f->points.clear();
+  f->point_ids.clear();
+  for (size_t i = 0; i < msg.points.size(); ++i) {
+    const Eigen::Vector2d n(msg.points[i].x, msg.points[i].y);
+    if (!all_finite(n)) continue;
+    f->points.push_back(camera.denormalize(n));
+    f->point_ids.push_back(static_cast<int64_t>(std::llround(ids->values[i])));
+  }
+  return true;
+}
+
+bool lines_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& camera,
+                     ExternalFeatures* f, std::string* reason) {
+  const sensor_msgs::ChannelFloat32* ids = channel(msg, 0, reason);
+  const sensor_msgs::ChannelFloat32* ex = ids ? channel(msg, 1, reason) : nullptr;
+  const sensor_msgs::ChannelFloat32* ey = ex ? channel(msg, 2, reason) : nullptr;
+  if (!ey) return false;
+  f->has_lines = true;
+  f->lines_undistorted = true;
+  f->lines.clear();
+  f->line_ids.clear();
+  for (size_t i = 0; i < msg.points.size(); ++i) {
+    const LineSegment s(camera.denormalize({msg.points[i].x, msg.points[i].y}),
+                        camera.denormalize({ex->values[i], ey->values[i]}));
+    if (!all_finite(s.p1) || !all_finite(s.p2) || !(s.length() > 0.0)) continue;
+    f->lines.push_back(s);
+    f->line_ids.push_back(static_cast<int64_t>(std::llround(ids->values[i])));
+  }
+  return true;
+}
+
+geometry_msgs::Transform to_transform(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  geometry_msgs::Transform tf;
+  const Eigen::Quaterniond q(R);
+  tf.rotation.x = q.x();
+  tf.rotation.y = q.y();
+  tf.rotation.z = q.z();
+  tf.rotation.w = q.w();
+  tf.translation.x = t.x();
+  tf.translation.y = t.y();
+  tf.translation.z = t.z();
+  return tf;
+}
+
+}  // namespace hybrid_vo

@@ -1,0 +1,388 @@
+// rostest of the VO node: publishes rendered frames (or rendered feature topics) like a bag replay
+// would, frame by frame, and asserts on tf, ~relative_pose and /diagnostics. The .test files pick
+// the scenario with --gtest_filter.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
+#include <hybrid_vo/FeatureLines.h>
+#include <hybrid_vo/FeaturePoints.h>
+#include <hybrid_vo/MotionEstimate.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/image_encodings.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "hybrid_vo/geometry/pose_error.h"
+#include "render/sequence.h"
+
+namespace hybrid_vo {
+namespace {
+
+constexpr double kDeg = 180.0 / M_PI;
+
+sensor_msgs::CameraInfo info_of(const PinholeCamera& c, const ros::Time& stamp,
+                                const std::string& frame, double tx = 0.0) {
+  sensor_msgs::CameraInfo info;
+  info.header.stamp = stamp;
+  info.header.frame_id = frame;
+  info.width = c.width;
+  info.height = c.height;
+  info.distortion_model = "plumb_bob";
+  info.D = {0, 0, 0, 0, 0};
+  info.K = {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
+  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  info.P = {c.fx, 0, c.cx, tx, 0, c.fy, c.cy, 0, 0, 0, 1, 0};
+  return info;
+}
+
+sensor_msgs::Image image_of(const cv::Mat& gray, const ros::Time& stamp, const std::string& frame) {
+  sensor_msgs::Image m;
+  m.header.stamp = stamp;
+  m.header.frame_id = frame;
+  m.encoding = sensor_msgs::image_encodings::MONO8;
+  m.width = gray.cols;
+  m.height = gray.rows;
+  m.step = gray.cols;
+  m.data.assign(gray.data, gray.data + gray.total());
+  return m;
+}
+
+// Publishes frames and waits for the node's answer to each, so that no frame is dropped.
+class NodeHarness {
+ public:
+  NodeHarness() : listener_(buffer_) {
+    ros::NodeHandle nh;
+    left_ = nh.advertise<sensor_msgs::Image>("camera/left/image_raw", 5);
+    left_info_ = nh.advertise<sensor_msgs::CameraInfo>("camera/left/camera_info", 5);
+    right_ = nh.advertise<sensor_msgs::Image>("camera/right/image_raw", 5);
+    right_info_ = nh.advertise<sensor_msgs::CameraInfo>("camera/right/camera_info", 5);
+    points_ = nh.advertise<FeaturePoints>("features/points", 5);
+    lines_ = nh.advertise<FeatureLines>("features/lines", 5);
+    motion_sub_ = nh.subscribe("hybrid_vo/relative_pose", 100, &NodeHarness::on_motion, this);
+    diagnostics_sub_ = nh.subscribe("/diagnostics", 100, &NodeHarness::on_diagnostics, this);
+  }
+
+  bool wait_for_node(double seconds = 20.0) {
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::ok() && ros::WallTime::now() < end) {
+      if (left_.getNumSubscribers() > 0 && left_info_.getNumSubscribers() > 0) return true;
+      ros::WallDuration(0.05).sleep();
+    }
+    return false;
+  }
+
+  // Waits for the ~relative_pose message of `stamp`.
+  bool wait_for(const ros::Time& stamp, double seconds = 20.0) {
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::ok() && ros::WallTime::now() < end) {
+      ros::spinOnce();
+      if (motions_.count(stamp)) return true;
+      ros::WallDuration(0.005).sleep();
+    }
+    return false;
+  }
+
+  void spin_for(double seconds) {
+    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+    while (ros::ok() && ros::WallTime::now() < end) {
+      ros::spinOnce();
+      ros::WallDuration(0.01).sleep();
+    }
+  }
+
+  void on_motion(const MotionEstimate::ConstPtr& m) { motions_[m->header.stamp] = *m; }
+  void on_diagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& d) {
+    for (const auto& s : d->status)
+      if (s.name.find("odometry") != std::string::npos) last_odometry_status_ = s;
+  }
+
+  ros::Publisher left_, left_info_, right_, right_info_, points_, lines_;
+  ros::Subscriber motion_sub_, diagnostics_sub_;
+  std::map<ros::Time, MotionEstimate> motions_;
+  diagnostic_msgs::DiagnosticStatus last_odometry_status_;
+  tf2_ros::Buffer buffer_;
+  tf2_ros::TransformListener listener_;
+  tf2_ros::StaticTransformBroadcaster static_broadcaster_;
+};
+
+void publish_static_camera(NodeHarness* h) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = ros::Time::now();
+  t.header.frame_id = "base_link";
+  t.child_frame_id = "camera_left_optical";
+  const Eigen::Quaterniond q(render::base_from_optical());
+  t.transform.rotation.w = q.w();
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  h->static_broadcaster_.sendTransform(t);
+}
+
+double diagnostic_value(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {
+  for (const auto& kv : s.values)
+    if (kv.key == key) return std::atof(kv.value.c_str());
+  return -1.0;
+}
+
+// The base's pose in odom implied by the ground truth (odom = the base at frame 0).
+Eigen::Isometry3d gt_odom_base(const render::Sequence& seq, int first, int frame) {
+  auto base = [&](int k) {
+    const render::CameraPose p = render::frame_pose(seq, k);
+    Eigen::Isometry3d w_cam = Eigen::Isometry3d::Identity();
+    w_cam.linear() = p.R_world_from_camera;
+    w_cam.translation() = p.centre;
+    Eigen::Isometry3d base_cam = Eigen::Isometry3d::Identity();
+    base_cam.linear() = render::base_from_optical();
+    return w_cam * base_cam.inverse();
+  };
+  return base(first).inverse() * base(frame);
+}
+
+TEST(Replay, RenderedStereoSequence) {
+  render::SequenceOptions options;
+  options.out_bag = "unused.bag";
+  options.frames = 40;
+  options.stereo = true;
+  options.width = 480;
+  options.height = 360;
+  options.supersampling = 2;
+  const render::Sequence seq = render::make_sequence(options);
+  NodeHarness h;
+  ASSERT_TRUE(h.wait_for_node());
+  publish_static_camera(&h);
+  h.spin_for(0.5);
+  double path = 0.0;
+  ros::Time last;
+  for (int i = 0; i < options.frames; ++i) {
+    const ros::Time stamp(1.0 + i / options.rate);
+    const render::RenderedView left = render::render_frame(seq, i, false);
+    const render::RenderedView right = render::render_frame(seq, i, true);
+    h.left_.publish(image_of(left.image, stamp, "camera_left_optical"));
+    h.left_info_.publish(info_of(seq.camera, stamp, "camera_left_optical"));
+    h.right_.publish(image_of(right.image, stamp, "camera_right_optical"));
+    h.right_info_.publish(
+        info_of(seq.camera, stamp, "camera_right_optical", -seq.camera.fx * options.baseline));
+    ASSERT_TRUE(h.wait_for(stamp)) << "no ~relative_pose for frame " << i;
+    if (i > 0)
+      path += (render::frame_pose(seq, i).centre - render::frame_pose(seq, i - 1).centre).norm();
+    last = stamp;
+  }
+  int ok = 0, metric = 0;
+  for (const auto& [stamp, m] : h.motions_) {
+    ok += m.status == MotionEstimate::STATUS_OK;
+    metric += m.scale_known;
+  }
+  EXPECT_GE(ok, options.frames * 3 / 4);
+  EXPECT_GE(metric, ok * 3 / 4);
+  h.spin_for(1.0);
+
+  geometry_msgs::TransformStamped tf;
+  ASSERT_NO_THROW(tf = h.buffer_.lookupTransform("odom", "base_link", last, ros::Duration(2.0)));
+  const Eigen::Isometry3d estimate = tf2::transformToEigen(tf);
+  const Eigen::Isometry3d truth = gt_odom_base(seq, 0, options.frames - 1);
+  const double rotation = rotation_error(estimate.rotation(), truth.rotation()) * kDeg;
+  const double position = (estimate.translation() - truth.translation()).norm();
+  EXPECT_LT(rotation, 2.0);
+  EXPECT_LT(position, 0.05 * path) << "path " << path << " m";
+  RecordProperty("final_rotation_error_deg", std::to_string(rotation));
+  RecordProperty("final_position_error_m", std::to_string(position));
+  RecordProperty("path_m", std::to_string(path));
+  EXPECT_EQ(h.last_odometry_status_.level, diagnostic_msgs::DiagnosticStatus::OK)
+      << h.last_odometry_status_.message;
+}
+
+// Features projected from the scene: corners painted on the walls and segments along the walls'
+// Manhattan directions, with stable ids. The images are black, so only these can explain a pose.
+struct RenderedFeatures {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::array<Eigen::Vector3d, 2>> segments;
+};
+
+RenderedFeatures scene_features(const render::Scene& scene) {
+  RenderedFeatures f;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (const render::Landmark& l : scene.landmarks) f.points.push_back(l.position);
+  for (const render::Quad& q : scene.quads) {
+    const int n = static_cast<int>(q.size_u * q.size_v * 3.0);
+    for (int k = 0; k < n; ++k) f.points.push_back(q.point(u01(rng) * q.size_u, u01(rng) * q.size_v));
+    for (int k = 0; k < std::max(2, n / 3); ++k) {
+      const double u = u01(rng) * q.size_u, v = u01(rng) * q.size_v;
+      const bool along_u = u01(rng) < 0.5;
+      const double half = 0.3 + 0.5 * u01(rng);
+      const Eigen::Vector3d axis = along_u ? q.u_axis : q.v_axis;
+      f.segments.push_back({q.point(u, v) - half * axis, q.point(u, v) + half * axis});
+    }
+  }
+  return f;
+}
+
+bool project(const render::CameraPose& pose, const PinholeCamera& c, const Eigen::Vector3d& X,
+             Eigen::Vector2d* x) {
+  const Eigen::Vector3d Xc = pose.to_camera(X);
+  if (Xc.z() < 0.3) return false;
+  *x = c.denormalize(Xc.head<2>() / Xc.z());
+  return x->x() >= 0 && x->y() >= 0 && x->x() < c.width - 1 && x->y() < c.height - 1;
+}
+
+TEST(FeatureTopics, EstimatorUsesTheGivenFeatures) {
+  render::SequenceOptions options;
+  options.out_bag = "unused.bag";
+  options.frames = 25;
+  options.width = 480;
+  options.height = 360;
+  const render::Sequence seq = render::make_sequence(options);
+  const RenderedFeatures features = scene_features(seq.scene);
+  NodeHarness h;
+  ASSERT_TRUE(h.wait_for_node());
+  publish_static_camera(&h);
+  h.spin_for(0.5);
+  const cv::Mat black(options.height, options.width, CV_8UC1, cv::Scalar(0));
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  for (int i = 0; i < options.frames; ++i) {
+    const ros::Time stamp(1.0 + i / options.rate);
+    const render::CameraPose pose = render::frame_pose(seq, i);
+    FeaturePoints points;
+    points.header.stamp = stamp;
+    for (size_t k = 0; k < features.points.size(); ++k) {
+      Eigen::Vector2d x;
+      if (!project(pose, seq.camera, features.points[k], &x)) continue;
+      points.ids.push_back(k);
+      points.x.push_back(x.x() + noise(rng));
+      points.y.push_back(x.y() + noise(rng));
+    }
+    FeatureLines lines;
+    lines.header.stamp = stamp;
+    for (size_t k = 0; k < features.segments.size(); ++k) {
+      Eigen::Vector2d a, b;
+      if (!project(pose, seq.camera, features.segments[k][0], &a) ||
+          !project(pose, seq.camera, features.segments[k][1], &b) || (a - b).norm() < 20.0)
+        continue;
+      lines.ids.push_back(k);
+      lines.x1.push_back(a.x() + noise(rng));
+      lines.y1.push_back(a.y() + noise(rng));
+      lines.x2.push_back(b.x() + noise(rng));
+      lines.y2.push_back(b.y() + noise(rng));
+    }
+    // Features first: the node must wait for the image and pair them by stamp.
+    h.points_.publish(points);
+    h.lines_.publish(lines);
+    h.left_.publish(image_of(black, stamp, "camera_left_optical"));
+    h.left_info_.publish(info_of(seq.camera, stamp, "camera_left_optical"));
+    ASSERT_TRUE(h.wait_for(stamp)) << "no ~relative_pose for frame " << i;
+  }
+  int ok = 0, with_lines = 0;
+  std::vector<double> rotation_errors;
+  for (const auto& [stamp, m] : h.motions_) {
+    if (m.status != MotionEstimate::STATUS_OK) continue;
+    ++ok;
+    EXPECT_GT(m.point_inliers, 10u);
+    EXPECT_LT(m.frontend_ms, 20.0);  // nothing was detected in the black images
+    with_lines += m.line_inliers > 5;
+    const int frame = static_cast<int>(std::lround((stamp.toSec() - 1.0) * options.rate));
+    const int ref = static_cast<int>(std::lround((m.reference_stamp.toSec() - 1.0) * options.rate));
+    const render::CameraPose a = render::frame_pose(seq, ref), b = render::frame_pose(seq, frame);
+    const Eigen::Matrix3d R_gt = b.R_world_from_camera.transpose() * a.R_world_from_camera;
+    const auto& q = m.transform.rotation;
+    const Eigen::Matrix3d R = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
+    rotation_errors.push_back(rotation_error(R, R_gt) * kDeg);
+  }
+  EXPECT_GE(ok, options.frames * 3 / 4);
+  EXPECT_GE(with_lines, ok / 2);
+  ASSERT_FALSE(rotation_errors.empty());
+  std::nth_element(rotation_errors.begin(), rotation_errors.begin() + rotation_errors.size() / 2,
+                   rotation_errors.end());
+  EXPECT_LT(rotation_errors[rotation_errors.size() / 2], 0.5);
+}
+
+// Bad input never crashes the node and shows up in diagnostics; it keeps working afterwards.
+TEST(BadInput, DiagnosticsAndRecovery) {
+  render::SequenceOptions options;
+  options.out_bag = "unused.bag";
+  options.frames = 12;
+  options.width = 320;
+  options.height = 240;
+  options.supersampling = 1;
+  const render::Sequence seq = render::make_sequence(options);
+  NodeHarness h;
+  ASSERT_TRUE(h.wait_for_node());
+  h.spin_for(0.5);
+  auto publish = [&](int i, double stamp, bool info = true, double info_offset = 0.0) {
+    const render::RenderedView v = render::render_frame(seq, i);
+    h.left_.publish(image_of(v.image, ros::Time(stamp), "camera_left_optical"));
+    if (info) h.left_info_.publish(info_of(seq.camera, ros::Time(stamp + info_offset), "camera_left_optical"));
+  };
+
+  // Images without camera_info: error in diagnostics, no frame processed.
+  for (int i = 0; i < 10; ++i) {
+    publish(i, 1.0 + 0.1 * i, false);
+    h.spin_for(0.3);
+  }
+  EXPECT_TRUE(h.motions_.empty());
+  EXPECT_EQ(h.last_odometry_status_.level, diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_NE(h.last_odometry_status_.message.find("camera_info"), std::string::npos)
+      << h.last_odometry_status_.message;
+
+  // Mismatched stamps under exact sync: nothing pairs up; same diagnosis.
+  for (int i = 0; i < 6; ++i) {
+    publish(i, 3.0 + 0.1 * i, true, 0.05);
+    h.spin_for(0.3);
+  }
+  EXPECT_TRUE(h.motions_.empty());
+  EXPECT_NE(h.last_odometry_status_.message.find("camera_info"), std::string::npos);
+
+  // Normal frames are processed.
+  for (int i = 0; i < 4; ++i) {
+    publish(i, 10.0 + 0.1 * i);
+    ASSERT_TRUE(h.wait_for(ros::Time(10.0 + 0.1 * i)));
+  }
+  // An empty image: skipped and counted, no crash.
+  sensor_msgs::Image empty;
+  empty.header.stamp = ros::Time(10.5);
+  empty.header.frame_id = "camera_left_optical";
+  empty.encoding = "mono8";
+  h.left_.publish(empty);
+  h.left_info_.publish(info_of(seq.camera, ros::Time(10.5), "camera_left_optical"));
+  h.spin_for(1.5);
+  EXPECT_GE(diagnostic_value(h.last_odometry_status_, "bad images"), 1.0);
+  // An invalid camera_info (zero focal length): skipped and counted.
+  sensor_msgs::CameraInfo broken = info_of(seq.camera, ros::Time(10.6), "camera_left_optical");
+  broken.K[0] = 0.0;
+  h.left_.publish(image_of(render::render_frame(seq, 5).image, ros::Time(10.6), "camera_left_optical"));
+  h.left_info_.publish(broken);
+  h.spin_for(1.5);
+  EXPECT_GE(diagnostic_value(h.last_odometry_status_, "invalid camera_info"), 1.0);
+
+  // Time going backwards (a bag loop): the node resets and goes on.
+  for (int i = 0; i < 4; ++i) {
+    publish(i, 2.0 + 0.1 * i);
+    ASSERT_TRUE(h.wait_for(ros::Time(2.0 + 0.1 * i)));
+  }
+  h.spin_for(1.5);  // diagnostics are published at most once a second
+  EXPECT_GE(diagnostic_value(h.last_odometry_status_, "time jumps (resets)"), 1.0);
+  const MotionEstimate& after_reset = h.motions_.at(ros::Time(2.0));
+  EXPECT_EQ(after_reset.status, MotionEstimate::STATUS_SKIPPED);  // a new first frame
+  EXPECT_EQ(h.motions_.at(ros::Time(2.3)).status, MotionEstimate::STATUS_OK);
+}
+
+}  // namespace
+}  // namespace hybrid_vo
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "hybrid_vo_rostest");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}

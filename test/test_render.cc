@@ -1,0 +1,559 @@
+// The synthetic sequence renderer: determinism, geometry (depth, painted corners, motion and
+// stereo consistent with the ground truth), image content that real detectors find (corners,
+// long segments through the Manhattan VPs), the walk, and option checking.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "render/sequence.h"
+
+namespace {
+
+using namespace hybrid_vo;
+using namespace hybrid_vo::render;
+
+constexpr double kPi = 3.14159265358979323846;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::infinity();
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return std::numeric_limits<double>::infinity();
+  const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * v.size()));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[k];
+}
+
+// Pixel of a world point, or false when it is behind the camera or outside the image by margin.
+bool project(const PinholeCamera& cam, const CameraPose& pose, const Eigen::Vector3d& X,
+             double margin, Eigen::Vector2d* pixel, double* depth) {
+  const Eigen::Vector3d Xc = pose.to_camera(X);
+  if (Xc.z() < 0.1) return false;
+  *pixel = Eigen::Vector2d(cam.fx * Xc.x() / Xc.z() + cam.cx, cam.fy * Xc.y() / Xc.z() + cam.cy);
+  *depth = Xc.z();
+  return pixel->x() >= margin && pixel->y() >= margin && pixel->x() <= cam.width - 1 - margin &&
+         pixel->y() <= cam.height - 1 - margin;
+}
+
+Eigen::Vector3d back_project(const PinholeCamera& cam, const CameraPose& pose, double x, double y,
+                             double depth) {
+  return pose.to_world(Eigen::Vector3d((x - cam.cx) / cam.fx, (y - cam.cy) / cam.fy, 1.0) * depth);
+}
+
+float bilinear(const cv::Mat& image, double x, double y) {
+  cv::Mat patch;
+  cv::getRectSubPix(image, cv::Size(1, 1),
+                    cv::Point2f(static_cast<float>(x), static_cast<float>(y)), patch, CV_32F);
+  return patch.at<float>(0, 0);
+}
+
+// The three Manhattan VPs (world axes) in homogeneous pixels.
+std::array<Eigen::Vector3d, 3> manhattan_vps(const PinholeCamera& cam, const CameraPose& pose) {
+  std::array<Eigen::Vector3d, 3> vps;
+  for (int k = 0; k < 3; ++k)
+    vps[k] = cam.K() * pose.R_world_from_camera.transpose() * Eigen::Vector3d::Unit(k);
+  return vps;
+}
+
+// Angle in degrees between a segment and the line from its midpoint to a homogeneous VP.
+double vp_angle_deg(const cv::Vec4f& s, const Eigen::Vector3d& vp) {
+  const Eigen::Vector2d a(s[0], s[1]), b(s[2], s[3]), m = 0.5 * (a + b);
+  const Eigen::Vector2d to_vp = vp.head<2>() - m * vp.z();
+  const Eigen::Vector2d d = b - a;
+  const double c = std::abs(d.dot(to_vp)) / (d.norm() * to_vp.norm() + 1e-300);
+  return std::acos(std::min(1.0, c)) * 180.0 / kPi;
+}
+
+class RenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    SequenceOptions options;
+    options.out_bag = "unused.bag";
+    options.frames = 120;
+    options.stereo = true;
+    sequence_ = new Sequence(make_sequence(options));
+  }
+  static void TearDownTestSuite() {
+    delete sequence_;
+    sequence_ = nullptr;
+  }
+  static const Sequence& seq() { return *sequence_; }
+  static Sequence* sequence_;
+};
+
+Sequence* RenderTest::sequence_ = nullptr;
+
+TEST_F(RenderTest, RenderingIsDeterministic) {
+  const RenderedView a = render_frame(seq(), 5);
+  const RenderedView b = render_frame(seq(), 5);
+  EXPECT_EQ(cv::norm(a.image, b.image, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a.depth, b.depth, cv::NORM_INF), 0.0);
+  // A second scene from the same seed is identical; another seed gives another scene.
+  SequenceOptions options = seq().options;
+  options.frames = 6;
+  const Sequence again = make_sequence(options);
+  EXPECT_EQ(cv::norm(render_frame(again, 5).image, a.image, cv::NORM_INF), 0.0);
+  options.seed = 2;
+  const Sequence other = make_sequence(options);
+  EXPECT_GT(cv::norm(render_frame(other, 5).image, a.image, cv::NORM_L1) / a.image.total(), 5.0);
+  // The noise differs between frames and cameras, not the picture.
+  const RenderedView right = render_frame(seq(), 5, true);
+  EXPECT_GT(cv::norm(right.image, a.image, cv::NORM_INF), 0.0);
+}
+
+TEST_F(RenderTest, SceneIsClosedAndManhattan) {
+  const Scene& scene = seq().scene;
+  int walls = 0;
+  for (const Quad& q : scene.quads) {
+    for (const Eigen::Vector3d& axis : {q.u_axis, q.v_axis, q.normal}) {
+      EXPECT_NEAR(axis.norm(), 1.0, 1e-12);
+      EXPECT_NEAR(axis.cwiseAbs().maxCoeff(), 1.0, 1e-12);  // a signed world axis
+    }
+    EXPECT_LT((q.v_axis.cross(q.u_axis) - q.normal).norm(), 1e-12);
+    EXPECT_FALSE(q.texture.levels.empty());
+    walls += q.kind == SurfaceKind::kWall;
+  }
+  EXPECT_EQ(walls, 8);  // the ring corridor: four outer and four inner walls
+  EXPECT_GE(scene.landmarks.size(), 30u);
+  // Every pixel of every tested view sees a surface: no holes in the geometry.
+  for (int frame : {0, 30, 60, 100}) {
+    const RenderedView view = render_frame(seq(), frame);
+    EXPECT_EQ(cv::countNonZero(view.quad_id < 0), 0) << "frame " << frame;
+    double min_depth = 0.0;
+    cv::minMaxLoc(view.depth, &min_depth);
+    EXPECT_GT(min_depth, 0.3) << "frame " << frame;
+  }
+}
+
+TEST_F(RenderTest, DepthBufferMatchesGeometry) {
+  const PinholeCamera& cam = seq().camera;
+  std::mt19937 rng(3);
+  for (int frame : {10, 40}) {
+    const CameraPose& pose = seq().trajectory.poses[frame];
+    const RenderedView view = render_frame(seq(), frame);
+    // Back-projected pixels lie on the plane and inside the extent of the quad they show.
+    for (int n = 0; n < 3000; ++n) {
+      const int x = static_cast<int>(rng() % cam.width), y = static_cast<int>(rng() % cam.height);
+      const int id = view.quad_id.at<int>(y, x);
+      ASSERT_GE(id, 0);
+      const Quad& q = seq().scene.quads[id];
+      const Eigen::Vector3d X = back_project(cam, pose, x, y, view.depth.at<float>(y, x));
+      const Eigen::Vector2d uv = q.local(X);
+      const double tol = 1e-5 * view.depth.at<float>(y, x) + 1e-6;
+      ASSERT_NEAR(q.normal.dot(X - q.origin), 0.0, tol);
+      ASSERT_GT(uv.x(), -tol);
+      ASSERT_GT(uv.y(), -tol);
+      ASSERT_LT(uv.x(), q.size_u + tol);
+      ASSERT_LT(uv.y(), q.size_v + tol);
+    }
+    // Independently: random points on the quads, projected; where the pixel centre's ray
+    // meets the same quad, the renderer must show it or something nearer, never farther.
+    int checked = 0, seen = 0;
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int n = 0; n < 50000; ++n) {
+      const int id = static_cast<int>(rng() % seq().scene.quads.size());
+      const Quad& q = seq().scene.quads[id];
+      if (q.normal.dot(pose.centre - q.origin) <= 0.0) continue;  // seen from behind
+      const Eigen::Vector3d P = q.point(unit(rng) * q.size_u, unit(rng) * q.size_v);
+      Eigen::Vector2d p;
+      double z = 0.0;
+      if (!project(cam, pose, P, 0.0, &p, &z)) continue;
+      const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+      const Eigen::Vector3d ray = back_project(cam, pose, x, y, 1.0) - pose.centre;
+      const double t = q.normal.dot(q.origin - pose.centre) / q.normal.dot(ray);
+      const Eigen::Vector2d uv = q.local(pose.centre + t * ray);
+      if (uv.x() < 1e-3 || uv.y() < 1e-3 || uv.x() > q.size_u - 1e-3 || uv.y() > q.size_v - 1e-3)
+        continue;
+      ++checked;
+      const double rendered = view.depth.at<float>(y, x);
+      EXPECT_LT(rendered, t * (1.0 + 1e-5)) << "quad " << id << " hidden behind a farther one";
+      if (view.quad_id.at<int>(y, x) == id) {
+        ++seen;
+        EXPECT_NEAR(rendered, t, 1e-5 * t);
+      }
+    }
+    EXPECT_GT(checked, 1000);
+    EXPECT_GT(seen, 300);
+  }
+}
+
+// The painted corners (door frames, posters, windows, boards) are image corners exactly where
+// the pose projects them: this checks the texture mapping, not only the depth.
+TEST_F(RenderTest, PaintedCornersProjectWhereExpected) {
+  const PinholeCamera& cam = seq().camera;
+  std::vector<double> errors;
+  for (int frame = 0; frame < 120; frame += 8) {
+    const CameraPose& pose = seq().trajectory.poses[frame];
+    const RenderedView view = render_frame(seq(), frame);
+    for (const Landmark& lm : seq().scene.landmarks) {
+      Eigen::Vector2d p;
+      double z = 0.0;
+      if (!project(cam, pose, lm.position, 12.0, &p, &z) || z > 5.0) continue;
+      const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+      // Visible: nothing in front, and the surface around it is its own quad.
+      bool visible = true;
+      for (int dy = -5; dy <= 5; ++dy)
+        for (int dx = -5; dx <= 5; ++dx)
+          visible = visible && view.quad_id.at<int>(y + dy, x + dx) == lm.quad;
+      if (!visible) continue;
+      // Facing the camera obliquely enough that the corner is not a sliver.
+      const Quad& q = seq().scene.quads[lm.quad];
+      const Eigen::Vector3d to_camera = (pose.centre - lm.position).normalized();
+      if (q.normal.dot(to_camera) < 0.5) continue;
+      std::vector<cv::Point2f> corner = {
+          cv::Point2f(static_cast<float>(p.x() + 1.2), static_cast<float>(p.y() - 0.8))};
+      cv::cornerSubPix(view.image, corner, cv::Size(3, 3), cv::Size(-1, -1),
+                       cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-3));
+      errors.push_back(std::hypot(corner[0].x - p.x(), corner[0].y - p.y()));
+    }
+  }
+  ASSERT_GE(errors.size(), 40u);
+  EXPECT_LT(median(errors), 0.35);
+  EXPECT_LT(quantile(errors, 0.8), 0.6);
+  RecordProperty("painted_corners", static_cast<int>(errors.size()));
+}
+
+// Consecutive frames are related by the ground-truth motion: warping frame i into frame i + 1
+// with the depth and the poses leaves only noise, and KLT tracks move where the motion says.
+TEST_F(RenderTest, ConsecutiveFramesAgreeWithGroundTruthMotion) {
+  const PinholeCamera& cam = seq().camera;
+  for (int frame : {8, 22, 29}) {  // straight, entering the first turn, at its fastest
+    const CameraPose& pose1 = seq().trajectory.poses[frame];
+    const CameraPose& pose2 = seq().trajectory.poses[frame + 1];
+    const RenderedView v1 = render_frame(seq(), frame), v2 = render_frame(seq(), frame + 1);
+    auto predict = [&](double x, double y, Eigen::Vector2d* p2) {
+      const Eigen::Vector3d X = back_project(cam, pose1, x, y, bilinear(v1.depth, x, y));
+      double z2 = 0.0;
+      if (!project(cam, pose2, X, 2.0, p2, &z2)) return false;
+      // Not occluded in frame 2, and not on a depth edge in frame 1.
+      const float d2 = v2.depth.at<float>(static_cast<int>(std::lround(p2->y())),
+                                          static_cast<int>(std::lround(p2->x())));
+      const int xi = static_cast<int>(std::lround(x)), yi = static_cast<int>(std::lround(y));
+      const int id = v1.quad_id.at<int>(yi, xi);
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+          const int yy = std::clamp(yi + dy, 0, cam.height - 1);
+          const int xx = std::clamp(xi + dx, 0, cam.width - 1);
+          if (v1.quad_id.at<int>(yy, xx) != id) return false;
+        }
+      return std::abs(d2 - z2) < 0.01 * z2;
+    };
+    std::vector<double> warped, unwarped;
+    for (int y = 4; y < cam.height - 4; y += 4)
+      for (int x = 4; x < cam.width - 4; x += 4) {
+        Eigen::Vector2d p2;
+        if (!predict(x, y, &p2)) continue;
+        const double i1 = v1.image.at<uchar>(y, x);
+        warped.push_back(std::abs(i1 - bilinear(v2.image, p2.x(), p2.y())));
+        unwarped.push_back(std::abs(i1 - v2.image.at<uchar>(y, x)));
+      }
+    ASSERT_GT(warped.size(), 8000u) << "frame " << frame;
+    EXPECT_LT(median(warped), 2.0) << "frame " << frame;
+    EXPECT_LT(quantile(warped, 0.9), 6.0) << "frame " << frame;
+    EXPECT_GT(quantile(unwarped, 0.9), 3.0 * quantile(warped, 0.9)) << "frame " << frame;
+
+    std::vector<cv::Point2f> corners, tracked;
+    cv::goodFeaturesToTrack(v1.image, corners, 500, 0.01, 8);
+    std::vector<uchar> status;
+    std::vector<float> error;
+    cv::calcOpticalFlowPyrLK(v1.image, v2.image, corners, tracked, status, error, cv::Size(21, 21),
+                             3);
+    std::vector<double> klt;
+    for (size_t k = 0; k < corners.size(); ++k) {
+      Eigen::Vector2d p2;
+      if (!status[k] || !predict(corners[k].x, corners[k].y, &p2)) continue;
+      klt.push_back(std::hypot(tracked[k].x - p2.x(), tracked[k].y - p2.y()));
+    }
+    ASSERT_GT(klt.size(), 100u) << "frame " << frame;
+    EXPECT_LT(median(klt), 0.3) << "frame " << frame;
+    EXPECT_LT(quantile(klt, 0.9), 1.5) << "frame " << frame;
+  }
+}
+
+// What the VO front end needs: hundreds of corners that repeat where the motion takes them
+// (aliasing would make corners that do not), and dozens of long segments, nearly all through
+// the three Manhattan VPs predicted from the pose.
+TEST_F(RenderTest, ImagesHaveRepeatableCornersAndManhattanSegments) {
+  const PinholeCamera& cam = seq().camera;
+  cv::Ptr<cv::LineSegmentDetector> lsd = cv::createLineSegmentDetector();
+  std::array<int, 3> total_per_vp = {0, 0, 0};
+  for (int frame : {0, 20, 30, 60, 90}) {
+    const CameraPose& pose = seq().trajectory.poses[frame];
+    const RenderedView view = render_frame(seq(), frame);
+    std::vector<cv::Point2f> corners;
+    cv::goodFeaturesToTrack(view.image, corners, 3000, 0.01, 5);
+    EXPECT_GE(corners.size(), 300u) << "frame " << frame;
+
+    // Repeatability in the next frame.
+    const RenderedView next = render_frame(seq(), frame + 1);
+    const CameraPose& pose2 = seq().trajectory.poses[frame + 1];
+    std::vector<cv::Point2f> corners2;
+    cv::goodFeaturesToTrack(next.image, corners2, 3000, 0.01, 5);
+    int predicted = 0, repeated = 0;
+    for (const cv::Point2f& c : corners) {
+      const float z = view.depth.at<float>(static_cast<int>(std::lround(c.y)),
+                                           static_cast<int>(std::lround(c.x)));
+      Eigen::Vector2d p2;
+      double z2 = 0.0;
+      if (!project(cam, pose2, back_project(cam, pose, c.x, c.y, z), 8.0, &p2, &z2)) continue;
+      const float d2 = next.depth.at<float>(static_cast<int>(std::lround(p2.y())),
+                                            static_cast<int>(std::lround(p2.x())));
+      if (std::abs(d2 - z2) > 0.01 * z2) continue;
+      ++predicted;
+      for (const cv::Point2f& c2 : corners2)
+        if (std::hypot(c2.x - p2.x(), c2.y - p2.y()) < 1.5) {
+          ++repeated;
+          break;
+        }
+    }
+    ASSERT_GT(predicted, 150) << "frame " << frame;
+    EXPECT_GT(static_cast<double>(repeated) / predicted, 0.6) << "frame " << frame;
+
+    std::vector<cv::Vec4f> segments;
+    lsd->detect(view.image, segments);
+    const auto vps = manhattan_vps(cam, pose);
+    int long_segments = 0, manhattan = 0;
+    std::array<int, 3> per_vp = {0, 0, 0};
+    for (const cv::Vec4f& s : segments) {
+      if (std::hypot(s[2] - s[0], s[3] - s[1]) < 40.0) continue;
+      ++long_segments;
+      int best = 0;
+      double best_angle = 180.0;
+      for (int k = 0; k < 3; ++k) {
+        const double a = vp_angle_deg(s, vps[k]);
+        if (a < best_angle) best_angle = a, best = k;
+      }
+      if (best_angle < 2.0) {
+        ++manhattan;
+        ++per_vp[best];
+      }
+    }
+    EXPECT_GE(long_segments, 30) << "frame " << frame;
+    EXPECT_GE(manhattan, 0.9 * long_segments) << "frame " << frame;
+    // Facing a wall, the direction towards it has few segments; the other two are always there.
+    EXPECT_GE(std::count_if(per_vp.begin(), per_vp.end(), [](int n) { return n >= 5; }), 2)
+        << "frame " << frame;
+    for (int k = 0; k < 3; ++k) total_per_vp[k] += per_vp[k];
+  }
+  for (int k = 0; k < 3; ++k) EXPECT_GE(total_per_vp[k], 20) << "VP " << k;
+}
+
+// Antialiasing: the default 3 x 3 rays per pixel are close to a 8 x 8 reference, at the edges
+// (where a single ray per pixel gives staircases) and on distant textures.
+TEST_F(RenderTest, SupersamplingConvergesToTheReference) {
+  RenderOptions options = seq().render;
+  options.noise_sigma = 0.0;
+  const CameraPose& pose = seq().trajectory.poses[30];
+  options.supersampling = 8;
+  const cv::Mat reference = render_view(seq().scene, seq().camera, pose, options).image;
+  auto error = [&](int ss, double* mean, double* q999) {
+    options.supersampling = ss;
+    cv::Mat diff;
+    cv::absdiff(render_view(seq().scene, seq().camera, pose, options).image, reference, diff);
+    *mean = cv::mean(diff)[0];
+    *q999 = quantile(std::vector<double>(diff.begin<uchar>(), diff.end<uchar>()), 0.999);
+  };
+  double mean3 = 0.0, q999_3 = 0.0, mean1 = 0.0, q999_1 = 0.0;
+  error(3, &mean3, &q999_3);
+  error(1, &mean1, &q999_1);
+  EXPECT_LT(mean3, 0.1);
+  EXPECT_LE(q999_3, 5.0);
+  EXPECT_GT(q999_1, 2.0 * q999_3);  // one ray per pixel is visibly worse: the test can tell
+}
+
+TEST_F(RenderTest, RightCameraIsLeftShiftedByTheBaseline) {
+  const PinholeCamera& cam = seq().camera;
+  const double B = seq().options.baseline;
+  for (int frame : {15, 45}) {
+    const CameraPose left = frame_pose(seq(), frame), right = frame_pose(seq(), frame, true);
+    EXPECT_LT((right.R_world_from_camera - left.R_world_from_camera).norm(), 1e-15);
+    EXPECT_LT((left.to_camera(right.centre) - Eigen::Vector3d(B, 0, 0)).norm(), 1e-12);
+    const RenderedView l = render_frame(seq(), frame), r = render_frame(seq(), frame, true);
+    std::vector<double> shifted, unshifted;
+    for (int y = 4; y < cam.height - 4; y += 3)
+      for (int x = 4; x < cam.width - 4; x += 3) {
+        const double z = l.depth.at<float>(y, x);
+        const double xr = x - cam.fx * B / z;  // rectified: same row, disparity f B / z
+        if (xr < 2.0) continue;
+        const float zr = r.depth.at<float>(y, static_cast<int>(std::lround(xr)));
+        if (std::abs(zr - z) > 0.01 * z) continue;  // occluded in the right view
+        const int id = l.quad_id.at<int>(y, x);
+        if (l.quad_id.at<int>(y, x - 2) != id || l.quad_id.at<int>(y, x + 2) != id) continue;
+        const double i = l.image.at<uchar>(y, x);
+        shifted.push_back(std::abs(i - bilinear(r.image, xr, y)));
+        unshifted.push_back(std::abs(i - r.image.at<uchar>(y, x)));
+      }
+    ASSERT_GT(shifted.size(), 10000u);
+    EXPECT_LT(median(shifted), 2.0) << "frame " << frame;
+    EXPECT_LT(quantile(shifted, 0.9), 5.0) << "frame " << frame;
+    EXPECT_GT(quantile(unshifted, 0.9), 2.0 * quantile(shifted, 0.9)) << "frame " << frame;
+  }
+}
+
+TEST_F(RenderTest, WalkTurnsAndStaysInside) {
+  const Trajectory& traj = seq().trajectory;
+  ASSERT_EQ(traj.poses.size(), 120u);
+  double min_heading = 0.0, max_heading = 0.0, heading = 0.0, previous = 0.0;
+  for (size_t i = 0; i < traj.poses.size(); ++i) {
+    const CameraPose& pose = traj.poses[i];
+    const Eigen::Matrix3d& R = pose.R_world_from_camera;
+    EXPECT_LT((R.transpose() * R - Eigen::Matrix3d::Identity()).norm(), 1e-12);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
+    EXPECT_TRUE(seq().scene.is_free(pose.centre, 0.5)) << "frame " << i;
+    const Eigen::Vector3d forward = R.col(2);
+    EXPECT_LT(std::abs(forward.z()), std::sin(10.0 * kPi / 180.0));  // roughly level
+    EXPECT_GT(R.col(1).z(), -1.0);
+    EXPECT_LT(R.col(1).z(), -0.95);  // image y points down
+    const double h = std::atan2(forward.y(), forward.x());
+    if (i > 0) {
+      heading += std::remainder(h - previous, 2.0 * kPi);
+      const double step = (pose.centre - traj.poses[i - 1].centre).norm();
+      EXPECT_NEAR(step, 0.15, 0.03) << "frame " << i;
+    }
+    previous = h;
+    min_heading = std::min(min_heading, heading);
+    max_heading = std::max(max_heading, heading);
+  }
+  EXPECT_GT((max_heading - min_heading) * 180.0 / kPi, 150.0);  // two left turns
+  EXPECT_NEAR(traj.total_turn_deg, 180.0, 5.0);
+  EXPECT_NEAR(traj.length, 119 * 0.15, 0.5);
+
+  // The room: a loop around the pillar, inside the walls too.
+  SceneOptions room;
+  room.type = SceneType::kRoom;
+  const Scene scene = build_scene(room);
+  PathOptions path;
+  path.num_frames = 200;
+  const Trajectory walk = make_trajectory(scene, path);
+  for (const CameraPose& pose : walk.poses) EXPECT_TRUE(scene.is_free(pose.centre, 0.5));
+  EXPECT_GT(walk.total_turn_deg, 45.0);
+}
+
+TEST(RenderOptions, StampsAreExact) {
+  EXPECT_EQ(frame_stamp_ns(0, 10.0), 1000000000ull);
+  EXPECT_EQ(frame_stamp_ns(1, 10.0), 1100000000ull);
+  EXPECT_EQ(frame_stamp_ns(3, 30.0), 1100000000ull);
+  EXPECT_EQ(frame_stamp_ns(149, 10.0), 15900000000ull);
+}
+
+TEST(RenderOptions, ArgumentsAreParsedAndBadOnesRejected) {
+  SequenceOptions o;
+  EXPECT_EQ(parse_sequence_args(
+                {"--out", "x.bag", "--frames", "20", "--stereo", "--width", "320", "--height",
+                 "240", "--rate", "20", "--seed", "7", "--scene", "room", "--png-dir", "/tmp/p"},
+                &o),
+            "");
+  EXPECT_EQ(o.out_bag, "x.bag");
+  EXPECT_EQ(o.frames, 20);
+  EXPECT_TRUE(o.stereo);
+  EXPECT_EQ(o.width, 320);
+  EXPECT_EQ(o.height, 240);
+  EXPECT_EQ(o.rate, 20.0);
+  EXPECT_EQ(o.seed, 7u);
+  EXPECT_EQ(o.scene, SceneType::kRoom);
+  EXPECT_EQ(o.png_dir, "/tmp/p");
+
+  const std::vector<std::vector<std::string>> bad = {
+      {},         // no --out
+      {"--out"},  // missing value
+      {"--out", "x.bag", "--frames", "0"},
+      {"--out", "x.bag", "--frames", "12abc"},
+      {"--out", "x.bag", "--frames", "-3"},
+      {"--out", "x.bag", "--width", "5"},
+      {"--out", "x.bag", "--height", "100000"},
+      {"--out", "x.bag", "--rate", "0"},
+      {"--out", "x.bag", "--rate", "nan"},
+      {"--out", "x.bag", "--seed", "-1"},
+      {"--out", "x.bag", "--scene", "garden"},
+      {"--out", "x.bag", "--baseline", "0"},
+      {"--out", "x.bag", "--speed", "9"},
+      {"--out", "x.bag", "--noise", "-1"},
+      {"--out", "x.bag", "--supersampling", "0"},
+      {"--out", "x.bag", "--compression", "zip"},
+      {"--out", "x.bag", "--bogus"},
+  };
+  for (const auto& args : bad) {
+    SequenceOptions options;
+    std::string joined;
+    for (const std::string& a : args) joined += a + " ";
+    EXPECT_NE(parse_sequence_args(args, &options), "") << joined;
+  }
+  SequenceOptions help;
+  EXPECT_EQ(parse_sequence_args({"--help"}, &help), "");
+  EXPECT_TRUE(help.help);
+
+  const std::string dir = testing::TempDir();
+  EXPECT_EQ(check_writable_file(dir + "/render_test.bag"), "");
+  EXPECT_NE(check_writable_file("/nonexistent_hybrid_vo_dir/x.bag"), "");
+  EXPECT_NE(check_writable_file(dir), "");  // a directory
+}
+
+TEST(RenderOptions, InvalidSceneCameraAndPathAreRejected) {
+  auto scene_with = [](auto change) {
+    SceneOptions o;
+    o.texels_per_metre = 64;
+    change(o);
+    return build_scene(o);
+  };
+  EXPECT_THROW(scene_with([](SceneOptions& o) { o.height = 1.0; }), std::invalid_argument);
+  EXPECT_THROW(scene_with([](SceneOptions& o) { o.corridor_width = 1.0; }), std::invalid_argument);
+  EXPECT_THROW(scene_with([](SceneOptions& o) { o.size_x = 5.0; }), std::invalid_argument);
+  EXPECT_THROW(scene_with([](SceneOptions& o) { o.texels_per_metre = 4.0; }),
+               std::invalid_argument);
+  EXPECT_THROW(scene_with([](SceneOptions& o) { o.num_furniture = -1; }), std::invalid_argument);
+  EXPECT_THROW(scene_with([](SceneOptions& o) { o.height = std::nan(""); }), std::invalid_argument);
+
+  const Scene scene = scene_with([](SceneOptions&) {});
+  auto path_with = [&](auto change) {
+    PathOptions p;
+    change(p);
+    return make_trajectory(scene, p);
+  };
+  EXPECT_THROW(path_with([](PathOptions& p) { p.num_frames = 0; }), std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.rate_hz = 0.0; }), std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.speed = 10.0; }), std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.camera_height = 2.6; }), std::invalid_argument);
+  EXPECT_NO_THROW(path_with([](PathOptions&) {}));
+
+  const CameraPose pose = make_trajectory(scene, PathOptions{}).poses[0];
+  PinholeCamera cam = default_camera(64, 48);
+  EXPECT_NO_THROW(render_view(scene, cam, pose));
+  PinholeCamera no_size = cam;
+  no_size.width = 0;
+  EXPECT_THROW(render_view(scene, no_size, pose), std::invalid_argument);
+  PinholeCamera bad_focal = cam;
+  bad_focal.fx = 0.0;
+  EXPECT_THROW(render_view(scene, bad_focal, pose), std::invalid_argument);
+  RenderOptions bad_ss;
+  bad_ss.supersampling = 0;
+  EXPECT_THROW(render_view(scene, cam, pose, bad_ss), std::invalid_argument);
+  CameraPose not_rotation = pose;
+  not_rotation.R_world_from_camera *= 2.0;
+  EXPECT_THROW(render_view(scene, cam, not_rotation), std::invalid_argument);
+}
+
+TEST_F(RenderTest, RendersQuickly) {
+  const auto start = std::chrono::steady_clock::now();
+  render_frame(seq(), 50);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  RecordProperty("render_ms", static_cast<int>(seconds * 1000));
+  EXPECT_LT(seconds, 2.0);  // about 0.2 s on two cores; loose for loaded CI machines
+}
+
+}  // namespace
