@@ -36,6 +36,9 @@ struct Arguments {
   std::string csv;
   int max_pairs = 0;
   uint64_t seed = 0;
+  int runs = 1;                   // RANSAC repetitions per pair and method, pooled into one AUC
+  int min_iterations = -1;        // overrides of the presets' RANSAC settings (-1: preset's own)
+  double point_threshold = -1.0;  // also used for OpenCV (default 1 px)
   FrontendOptions frontend;
 };
 
@@ -44,10 +47,13 @@ void usage(const char* program) {
       << "Usage: " << program << " --format {kitti,tum,strecha,superglue} PATH\n"
       << "         [--images DIR] [--gap K] [--resize S] [--presets a,b,...] [--csv FILE]\n"
       << "         [--vp-modes] [--max-pairs N] [--points sift|orb] [--lines lsd|fld] [--seed S]\n"
+      << "         [--runs N] [--min-iterations N] [--point-threshold PX]\n"
       << "  Pairs are frames i and i+K (superglue: the pairs file, images under --images).\n"
       << "  Prints method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms (AUC in %),\n"
       << "  one row per preset plus opencv_usac_magsac (findEssentialMat + recoverPose on the same\n"
-      << "  points). --vp-modes adds the VP ablation: standard, joint, joint+refined.\n";
+      << "  points). --vp-modes adds the VP ablation: standard, joint, joint+refined.\n"
+      << "  --runs N repeats every estimator N times per pair with different seeds and pools the\n"
+      << "  errors, so that one unlucky RANSAC run does not decide a small data set's AUC.\n";
 }
 
 bool parse(int argc, char** argv, Arguments* a) {
@@ -96,6 +102,17 @@ bool parse(int argc, char** argv, Arguments* a) {
       if (*end || a->max_pairs < 0) return std::cerr << "error: bad --max-pairs\n", false;
     } else if (arg == "--seed") {
       a->seed = std::strtoull(v.c_str(), &end, 10);
+    } else if (arg == "--runs") {
+      a->runs = static_cast<int>(std::strtol(v.c_str(), &end, 10));
+      if (*end || a->runs < 1) return std::cerr << "error: --runs must be >= 1\n", false;
+    } else if (arg == "--min-iterations") {
+      a->min_iterations = static_cast<int>(std::strtol(v.c_str(), &end, 10));
+      if (*end || a->min_iterations < 1)
+        return std::cerr << "error: --min-iterations must be >= 1\n", false;
+    } else if (arg == "--point-threshold") {
+      a->point_threshold = std::strtod(v.c_str(), &end);
+      if (*end || !(a->point_threshold > 0.0))
+        return std::cerr << "error: --point-threshold must be > 0\n", false;
     } else if (arg == "--points") {
       if (v == "orb") a->frontend.points.type = PointFeatureType::kOrb;
       else if (v != "sift") return std::cerr << "error: --points must be sift or orb\n", false;
@@ -160,7 +177,7 @@ class FeatureCache {
 // OpenCV's USAC_MAGSAC essential matrix plus recoverPose, on normalised points when the two
 // cameras differ (its API takes one K).
 double run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const PinholeCamera& c2,
-                  const RelativePose& truth, double* ms) {
+                  const RelativePose& truth, double threshold_px, double* ms) {
   const auto start = std::chrono::steady_clock::now();
   double error = kFailed;
   if (m.points.size() >= 5) {
@@ -173,7 +190,7 @@ double run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const Pinhol
     const double f = 0.5 * (c1.mean_focal() + c2.mean_focal());
     cv::Mat mask;
     const cv::Mat E = cv::findEssentialMat(p1, p2, cv::Mat::eye(3, 3, CV_64F), cv::USAC_MAGSAC,
-                                           0.999, 1.0 / f, mask);
+                                           0.999, threshold_px / f, mask);
     if (E.rows == 3 && E.cols == 3) {
       cv::Mat R, t;
       if (cv::recoverPose(E, p1, p2, cv::Mat::eye(3, 3, CV_64F), R, t, mask) > 0) {
@@ -279,23 +296,29 @@ int main(int argc, char** argv) {
             << ',' << matches.lines.size() << ',' << vps << ',' << ms << '\n';
     };
 
-    for (const std::string& preset : args.presets) {
-      TwoViewOptions options;
-      preset_options(preset, &options.estimator);
-      options.estimator.ransac.seed = args.seed + p;
-      const auto start = std::chrono::steady_clock::now();
-      const TwoViewEstimate result =
-          estimate_two_view(c0.pinhole, c1.pinhole, matches, options);
-      const double ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-              .count();
-      const bool ok = result.estimate.status == EstimationStatus::kOk;
-      record(preset, ok ? &result.estimate.pose : nullptr, ms,
-             static_cast<int>(result.vps.matches.size()));
+    for (int run = 0; run < args.runs; ++run) {
+      for (const std::string& preset : args.presets) {
+        TwoViewOptions options;
+        preset_options(preset, &options.estimator);
+        if (args.min_iterations > 0) options.estimator.ransac.min_iterations = args.min_iterations;
+        if (args.point_threshold > 0.0)
+          options.estimator.ransac.point_threshold_px = args.point_threshold;
+        options.estimator.ransac.seed = args.seed + p + 1000003ull * run;
+        const auto start = std::chrono::steady_clock::now();
+        const TwoViewEstimate result =
+            estimate_two_view(c0.pinhole, c1.pinhole, matches, options);
+        const double ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        const bool ok = result.estimate.status == EstimationStatus::kOk;
+        record(preset, ok ? &result.estimate.pose : nullptr, ms,
+               static_cast<int>(result.vps.matches.size()));
+      }
     }
-    if (args.opencv) {
+    for (int run = 0; args.opencv && run < args.runs; ++run) {
       double ms = 0.0;
-      const double e = run_opencv(matches, c0.pinhole, c1.pinhole, truth, &ms);
+      const double e = run_opencv(matches, c0.pinhole, c1.pinhole, truth,
+                                 args.point_threshold > 0.0 ? args.point_threshold : 1.0, &ms);
       stats["opencv_usac_magsac"].errors.push_back(e);
       stats["opencv_usac_magsac"].estimator_ms.push_back(ms);
       if (csv)

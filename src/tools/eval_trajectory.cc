@@ -34,6 +34,12 @@ void usage(const char* program) {
                "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n";
 }
 
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
 StampedPose from_transform(double stamp, const geometry_msgs::Transform& t) {
   StampedPose p;
   p.stamp = stamp;
@@ -248,6 +254,19 @@ int main(int argc, char** argv) {
               "drift %.2f %% and %.3f deg/100 m over %d segments\n",
               failures, skipped, te.pairs + 1, with_scale ? "aligned" : "metric", te.scale,
               te.drift_trans_percent, te.drift_rot_deg_per_100m, te.drift_segments);
+  // Processing time per frame as the node measured it (MotionEstimate), skipped frames included:
+  // what bounds the frame rate through the node.
+  std::vector<double> frontend_ms, estimator_ms, total_ms;
+  for (const hybrid_vo::MotionEstimate& m : run.motions) {
+    frontend_ms.push_back(m.frontend_ms);
+    estimator_ms.push_back(m.estimator_ms);
+    total_ms.push_back(m.frontend_ms + m.estimator_ms);
+  }
+  if (!total_ms.empty())
+    std::printf("# per frame (median): front end %.1f ms, estimator %.1f ms, total %.1f ms = %.1f "
+                "frames/s\n",
+                median_of(frontend_ms), median_of(estimator_ms), median_of(total_ms),
+                1000.0 / std::max(1e-3, median_of(total_ms)));
   std::printf("summary: pairs=%zu auc5=%.2f auc10=%.2f auc20=%.2f rpe_trans=%.4f rpe_rot_deg=%.4f "
               "ate=%.4f\n",
               errors.size(), 100.0 * hybrid_vo::pose_auc(errors, 5.0),
