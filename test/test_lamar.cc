@@ -65,9 +65,10 @@ struct SessionText {
     if (!rigs.empty()) write_file(dir / "rigs.txt", lines(rigs));
     if (!trajectories.empty()) write_file(dir / "trajectories.txt", lines(trajectories));
     if (!images.empty()) write_file(dir / "images.txt", lines(images));
-    if (!alignment.empty()) write_file(dir / "proc" / "alignment_trajectories.txt", lines(alignment));
-    for (const char* image : {"images/cam0/1000.png", "images/cam0/2000.png",
-                              "images/cam1/1000.png"})
+    if (!alignment.empty())
+      write_file(dir / "proc" / "alignment_trajectories.txt", lines(alignment));
+    for (const char* image :
+         {"images/cam0/1000.png", "images/cam0/2000.png", "images/cam1/1000.png"})
       write_file(dir / "raw_data" / image, "not decoded by the reader");
   }
 };
@@ -201,16 +202,16 @@ TEST(Lamar, PhoneCamerasPerFrameFormOneStream) {
   TempDir dir("test_lamar");
   SessionText text(dir.path());
   text.rigs.clear();
-  text.sensors = {"cam_phone_1000, phone camera for timestamp 1000, camera, PINHOLE, 40, 30, "
-                  "50, 50, 20, 15",
-                  "cam_phone_2000, phone camera for timestamp 2000, camera, PINHOLE, 30, 40, "
-                  "51, 51, 15, 20",
-                  "cam0, , camera, PINHOLE, 40, 30, 50, 50, 20, 15"};
+  text.sensors = {
+      "cam_phone_1000, phone camera for timestamp 1000, camera, PINHOLE, 40, 30, "
+      "50, 50, 20, 15",
+      "cam_phone_2000, phone camera for timestamp 2000, camera, PINHOLE, 30, 40, "
+      "51, 51, 15, 20",
+      "cam0, , camera, PINHOLE, 40, 30, 50, 50, 20, 15"};
   text.trajectories = {"1000, cam_phone_1000, 1, 0, 0, 0, 0, 0, 0",
                        "2000, cam_phone_2000, 1, 0, 0, 0, 1, 0, 0"};
   text.images = {"2000, cam_phone_2000, images/cam0/2000.png",
-                 "1000, cam_phone_1000, images/cam0/1000.png",
-                 "1000, cam0, images/cam1/1000.png"};
+                 "1000, cam_phone_1000, images/cam0/1000.png", "1000, cam0, images/cam1/1000.png"};
   text.write();
   LamarSession session;
   std::string error;
@@ -239,8 +240,7 @@ TEST(Lamar, ReportsMissingFilesAndMalformedLines) {
   const std::vector<BrokenCase> cases = {
       {"no sensors.txt", [](SessionText* t) { t->sensors.clear(); }, "sensors.txt", 0,
        "no such file"},
-      {"no images.txt", [](SessionText* t) { t->images.clear(); }, "images.txt", 0,
-       "no such file"},
+      {"no images.txt", [](SessionText* t) { t->images.clear(); }, "images.txt", 0, "no such file"},
       {"only comments in images.txt", [](SessionText* t) { t->images = {"# nothing"}; },
        "images.txt", 0, "no images"},
       {"PINHOLE with 3 parameters",
@@ -254,12 +254,13 @@ TEST(Lamar, ReportsMissingFilesAndMalformedLines) {
       {"image size not a number",
        [](SessionText* t) { t->sensors[1] = "cam0, , camera, PINHOLE, 640.5, 480, 1, 1, 1, 1"; },
        "sensors.txt", 2, "not two positive integers"},
-      {"duplicate sensor", [](SessionText* t) { t->sensors[2] = t->sensors[1]; }, "sensors.txt",
-       3, "duplicate sensor 'cam0'"},
-      {"sensor line too short", [](SessionText* t) { t->sensors.push_back("x, y"); },
-       "sensors.txt", 5, "found 2 fields"},
-      {"rig of an unknown sensor", [](SessionText* t) { t->rigs.push_back("rig, cam9, 1, 0, 0, 0, 0, 0, 0"); },
-       "rigs.txt", 4, "unknown sensor 'cam9'"},
+      {"duplicate sensor", [](SessionText* t) { t->sensors[2] = t->sensors[1]; }, "sensors.txt", 3,
+       "duplicate sensor 'cam0'"},
+      {"sensor line too short", [](SessionText* t) { t->sensors.push_back("x, y"); }, "sensors.txt",
+       5, "found 2 fields"},
+      {"rig of an unknown sensor",
+       [](SessionText* t) { t->rigs.push_back("rig, cam9, 1, 0, 0, 0, 0, 0, 0"); }, "rigs.txt", 4,
+       "unknown sensor 'cam9'"},
       {"rig line with 8 fields", [](SessionText* t) { t->rigs[1] = "rig, cam0, 1, 0, 0, 0, 0, 0"; },
        "rigs.txt", 2, "expected 9 fields"},
       {"trajectory with NaN",
@@ -278,10 +279,9 @@ TEST(Lamar, ReportsMissingFilesAndMalformedLines) {
        [](SessionText* t) { t->trajectories[2] = "2000, headset, 1, 0, 0, 0, 0, 0, 0"; },
        "trajectories.txt", 3, "unknown device 'headset'"},
       {"second pose at a time",
-       [](SessionText* t) { t->trajectories.push_back(t->trajectories[1]); },
-       "trajectories.txt", 4, "second pose of 'rig' at 1000"},
-      {"bad alignment file",
-       [](SessionText* t) { t->alignment = {"1000, rig, 1, 0, 0, 0, 0, 0"}; },
+       [](SessionText* t) { t->trajectories.push_back(t->trajectories[1]); }, "trajectories.txt", 4,
+       "second pose of 'rig' at 1000"},
+      {"bad alignment file", [](SessionText* t) { t->alignment = {"1000, rig, 1, 0, 0, 0, 0, 0"}; },
        "proc/alignment_trajectories.txt", 1, "expected 9 fields"},
       {"image of an unknown sensor",
        [](SessionText* t) { t->images.push_back("3000, cam7, images/cam0/1000.png"); },
@@ -306,7 +306,8 @@ TEST(Lamar, ReportsMissingFilesAndMalformedLines) {
     LamarSession session;
     std::string error;
     EXPECT_FALSE(read_lamar_session(dir.path().string(), &session, &error));
-    const std::string where = text.path(c.file) + (c.line > 0 ? ":" + std::to_string(c.line) : "") + ": ";
+    const std::string where =
+        text.path(c.file) + (c.line > 0 ? ":" + std::to_string(c.line) : "") + ": ";
     EXPECT_TRUE(contains(error, where));
     EXPECT_TRUE(contains(error, c.message));
   }
