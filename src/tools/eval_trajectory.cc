@@ -248,6 +248,25 @@ int main(int argc, char** argv) {
               "drift %.2f %% and %.3f deg/100 m over %d segments\n",
               failures, skipped, te.pairs + 1, with_scale ? "aligned" : "metric", te.scale,
               te.drift_trans_percent, te.drift_rot_deg_per_100m, te.drift_segments);
+  if (!run.motions.empty()) {
+    // The node's own time per processed frame (skipped frames included: they are tracked too).
+    std::vector<double> frontend, estimator, total;
+    for (const hybrid_vo::MotionEstimate& m : run.motions) {
+      frontend.push_back(m.frontend_ms);
+      estimator.push_back(m.estimator_ms);
+      total.push_back(m.frontend_ms + m.estimator_ms);
+    }
+    auto median = [](std::vector<double> v) {
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    double sum = 0.0;
+    for (double t : total) sum += t;
+    std::printf("# node time per frame (median): front end %.1f ms, estimator %.1f ms; "
+                "mean total %.1f ms = %.1f frames/s over %zu frames\n",
+                median(frontend), median(estimator), sum / total.size(),
+                1000.0 * total.size() / sum, total.size());
+  }
   std::printf("summary: pairs=%zu auc5=%.2f auc10=%.2f auc20=%.2f rpe_trans=%.4f rpe_rot_deg=%.4f "
               "ate=%.4f\n",
               errors.size(), 100.0 * hybrid_vo::pose_auc(errors, 5.0),
