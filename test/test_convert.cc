@@ -369,6 +369,11 @@ TEST(KittiToBag, Executable) {
   EXPECT_EQ(run(command, &output), 0) << output;
   EXPECT_TRUE(contains(output, "converted 5 frames (mono, 160x96), ground truth from"));
   EXPECT_EQ(read_bag(bag.string()).ground_truth.size(), 5u);
+  // A relative sequence folder still finds <root>/poses.
+  const std::string relative = "cd " + (dir.path() / "sequences").string() + " && " + tool +
+                               " --sequence 07 --out " + bag.string();
+  EXPECT_EQ(run(relative, &output), 0) << output;
+  EXPECT_TRUE(contains(output, "ground truth from ../poses/07.txt"));
   EXPECT_EQ(run(tool + " --sequence x", &output), 2);
   EXPECT_TRUE(contains(output, "--out OUT.bag is required"));
 }

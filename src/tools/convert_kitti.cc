@@ -24,7 +24,7 @@ using datasets::located;
 // The poses file to use: the given one, else <root>/poses/<name>.txt if present, else none.
 std::string poses_path_of(const KittiBagOptions& options, const fs::path& sequence_dir) {
   if (!options.poses.empty()) return options.poses;
-  const fs::path guess = sequence_dir.parent_path().parent_path() / "poses" /
+  const fs::path guess = (sequence_dir / ".." / ".." / "poses").lexically_normal() /
                          (sequence_dir.filename().string() + ".txt");
   std::error_code ec;
   return fs::exists(guess, ec) ? guess.string() : "";
