@@ -26,6 +26,7 @@
 #include "datasets/readers.h"
 #include "datasets/sequence.h"
 #include "datasets/text_file.h"
+#include "file_test_utils.h"
 #include "hybrid_vo/geometry/rotation.h"
 
 namespace hybrid_vo {
@@ -33,33 +34,12 @@ namespace datasets {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::contains;
+using testing::TempDir;
+using testing::write_file;
 
 // ------------------------------------------------------------------------------------------------
 // Helpers
-
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "test_datasets_XXXXXX").string();
-    if (!mkdtemp(pattern.data())) std::abort();
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-void write_file(const fs::path& path, const std::string& content) {
-  fs::create_directories(path.parent_path());
-  std::ofstream out(path);
-  out << content;
-  ASSERT_TRUE(out.good()) << path;
-}
 
 std::string join_lines(const std::vector<std::string>& lines) {
   std::string text;
@@ -75,11 +55,6 @@ std::string numbers(std::initializer_list<double> values) {
     text += (text.empty() ? "" : " ") + std::string(buffer);
   }
   return text;
-}
-
-::testing::AssertionResult contains(const std::string& text, const std::string& part) {
-  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
 }
 
 void expect_pose_near(const RelativePose& actual, const Eigen::Matrix3d& R,

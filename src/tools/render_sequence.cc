@@ -8,85 +8,22 @@
 #include <string>
 #include <vector>
 
-#include <cv_bridge/cv_bridge.h>
-#include <geometry_msgs/PoseStamped.h>
-#include <geometry_msgs/TransformStamped.h>
 #include <ros/time.h>
-#include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
-#include <sensor_msgs/CameraInfo.h>
-#include <sensor_msgs/image_encodings.h>
-#include <tf2_msgs/TFMessage.h>
-#include <Eigen/Geometry>
 #include <opencv2/imgcodecs.hpp>
 
+#include "bag_writing.h"
 #include "render/sequence.h"
 
 namespace {
 
-using hybrid_vo::PinholeCamera;
+using hybrid_vo::tools::BagOutput;
 using namespace hybrid_vo::render;
-
-const char kWorld[] = "world";
-const char kGroundTruth[] = "gt_camera_left_optical";
-const char kBase[] = "base_link";
-const char kLeft[] = "camera_left_optical";
-const char kRight[] = "camera_right_optical";
 
 ros::Time stamp_of(int frame, double rate) {
   ros::Time t;
   t.fromNSec(frame_stamp_ns(frame, rate));
   return t;
-}
-
-// ROS camera_info of a rectified camera; tx = -fx * baseline for the right camera of a pair.
-sensor_msgs::CameraInfo camera_info(const PinholeCamera& cam, const std::string& frame,
-                                    const ros::Time& stamp, double tx) {
-  sensor_msgs::CameraInfo info;
-  info.header.stamp = stamp;
-  info.header.frame_id = frame;
-  info.width = cam.width;
-  info.height = cam.height;
-  info.distortion_model = "plumb_bob";
-  info.D.assign(5, 0.0);
-  info.K = {cam.fx, 0.0, cam.cx, 0.0, cam.fy, cam.cy, 0.0, 0.0, 1.0};
-  info.R = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
-  info.P = {cam.fx, 0.0, cam.cx, tx, 0.0, cam.fy, cam.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
-  return info;
-}
-
-geometry_msgs::Transform to_transform(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
-  Eigen::Quaterniond q(R);
-  if (q.w() < 0.0) q.coeffs() *= -1.0;  // the same rotation; w >= 0 reads better
-  geometry_msgs::Transform tf;
-  tf.translation.x = t.x();
-  tf.translation.y = t.y();
-  tf.translation.z = t.z();
-  tf.rotation.x = q.x();
-  tf.rotation.y = q.y();
-  tf.rotation.z = q.z();
-  tf.rotation.w = q.w();
-  return tf;
-}
-
-geometry_msgs::TransformStamped stamped(const std::string& parent, const std::string& child,
-                                        const ros::Time& stamp,
-                                        const geometry_msgs::Transform& tf) {
-  geometry_msgs::TransformStamped s;
-  s.header.stamp = stamp;
-  s.header.frame_id = parent;
-  s.child_frame_id = child;
-  s.transform = tf;
-  return s;
-}
-
-void write_image(rosbag::Bag* bag, const std::string& topic, const std::string& frame,
-                 const ros::Time& stamp, const cv::Mat& image) {
-  std_msgs::Header header;
-  header.stamp = stamp;
-  header.frame_id = frame;
-  bag->write(topic, stamp,
-             *cv_bridge::CvImage(header, sensor_msgs::image_encodings::MONO8, image).toImageMsg());
 }
 
 }  // namespace
@@ -121,50 +58,49 @@ int main(int argc, char** argv) {
   try {
     const auto t_start = std::chrono::steady_clock::now();
     const Sequence seq = make_sequence(options);
-    rosbag::Bag bag;
-    bag.open(options.out_bag, rosbag::bagmode::Write);
-    if (options.compression == "lz4") bag.setCompression(rosbag::compression::LZ4);
-    if (options.compression == "bz2") bag.setCompression(rosbag::compression::BZ2);
+    namespace tools = hybrid_vo::tools;
+    const rosbag::compression::CompressionType compression =
+        options.compression == "lz4"   ? rosbag::compression::LZ4
+        : options.compression == "bz2" ? rosbag::compression::BZ2
+                                       : rosbag::compression::Uncompressed;
+    BagOutput out;
+    std::string bag_error;
+    if (!out.open(options.out_bag, compression, &bag_error)) {
+      std::cerr << "error: cannot write the bag: " << bag_error << "\n";
+      return 1;
+    }
+    const std::string left = tools::optical_frame("left"), right = tools::optical_frame("right");
 
-    // Static transforms, latched as a tf2 static broadcaster would publish them.
     const ros::Time t0 = stamp_of(0, options.rate);
-    tf2_msgs::TFMessage statics;
-    statics.transforms.push_back(
-        stamped(kBase, kLeft, t0, to_transform(base_from_optical(), Eigen::Vector3d::Zero())));
+    std::vector<geometry_msgs::TransformStamped> statics = {tools::stamped(
+        tools::kBaseFrame, left, t0,
+        tools::to_transform(base_from_optical(), Eigen::Vector3d::Zero()))};
     if (options.stereo) {
       const Eigen::Vector3d right_in_base =
           base_from_optical() * Eigen::Vector3d(options.baseline, 0.0, 0.0);
-      statics.transforms.push_back(
-          stamped(kBase, kRight, t0, to_transform(base_from_optical(), right_in_base)));
+      statics.push_back(tools::stamped(tools::kBaseFrame, right, t0,
+                                       tools::to_transform(base_from_optical(), right_in_base)));
     }
-    // A given connection header replaces rosbag's own, so it carries the type fields too.
-    auto latched = boost::make_shared<ros::M_string>();
-    (*latched)["topic"] = "/tf_static";
-    (*latched)["type"] = ros::message_traits::datatype<tf2_msgs::TFMessage>();
-    (*latched)["md5sum"] = ros::message_traits::md5sum<tf2_msgs::TFMessage>();
-    (*latched)["message_definition"] = ros::message_traits::definition<tf2_msgs::TFMessage>();
-    (*latched)["callerid"] = "/hybrid_vo_render_sequence";
-    (*latched)["latching"] = "1";
-    bag.write("/tf_static", t0, statics, latched);
+    out.write_tf_static(t0, statics, "/hybrid_vo_render_sequence");
 
     const double tx_right = -seq.camera.fx * options.baseline;
     double render_seconds = 0.0;
     for (int i = 0; i < options.frames; ++i) {
       const ros::Time t = stamp_of(i, options.rate);
       for (int side = 0; side < (options.stereo ? 2 : 1); ++side) {
-        const bool right = side == 1;
+        const bool is_right = side == 1;
         const auto r0 = std::chrono::steady_clock::now();
-        const RenderedView view = render_frame(seq, i, right);
+        const RenderedView view = render_frame(seq, i, is_right);
         render_seconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-        const std::string prefix = right ? "/camera/right" : "/camera/left";
-        const std::string frame = right ? kRight : kLeft;
-        write_image(&bag, prefix + "/image_raw", frame, t, view.image);
-        bag.write(prefix + "/camera_info", t,
-                  camera_info(seq.camera, frame, t, right ? tx_right : 0.0));
+        const std::string prefix = tools::camera_topic(is_right ? "right" : "left");
+        const std::string& frame = is_right ? right : left;
+        out.write_image(prefix + "/image_raw", frame, t, view.image);
+        out.bag().write(prefix + "/camera_info", t,
+                        tools::make_camera_info(seq.camera, frame, t, is_right ? tx_right : 0.0));
         if (!options.png_dir.empty()) {
           char name[64];
-          std::snprintf(name, sizeof(name), "%s_%06d.png", right ? "right" : "left", i);
+          std::snprintf(name, sizeof(name), "%s_%06d.png", is_right ? "right" : "left", i);
           const std::string file = (std::filesystem::path(options.png_dir) / name).string();
           if (!cv::imwrite(file, view.image)) {
             std::cerr << "error: cannot write " << file << "\n";
@@ -173,20 +109,13 @@ int main(int argc, char** argv) {
         }
       }
       const CameraPose& pose = seq.trajectory.poses[i];
-      const geometry_msgs::Transform tf = to_transform(pose.R_world_from_camera, pose.centre);
-      geometry_msgs::PoseStamped gt;
-      gt.header.stamp = t;
-      gt.header.frame_id = kWorld;
-      gt.pose.position.x = tf.translation.x;
-      gt.pose.position.y = tf.translation.y;
-      gt.pose.position.z = tf.translation.z;
-      gt.pose.orientation = tf.rotation;
-      bag.write("/ground_truth/pose", t, gt);
-      tf2_msgs::TFMessage tf_msg;
-      tf_msg.transforms.push_back(stamped(kWorld, kGroundTruth, t, tf));
-      bag.write("/tf", t, tf_msg);
+      out.write_ground_truth(tools::ground_truth_frame(left), t, pose.R_world_from_camera,
+                             pose.centre);
     }
-    bag.close();
+    if (!out.commit(&bag_error)) {
+      std::cerr << "error: " << bag_error << "\n";
+      return 1;
+    }
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const int views = options.frames * (options.stereo ? 2 : 1);

@@ -1,4 +1,6 @@
-// KITTI odometry reader (see readers.h for the layout).
+// KITTI odometry: the files of the layout (kitti.h) and the sequence reader (readers.h).
+#include "datasets/kitti.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -25,6 +27,19 @@ bool read_records(const std::string& path, std::vector<std::string>* records,
     if (split_fields((*records)[k]).empty())
       return fail(error, located(path, static_cast<int>(k + 1), "empty line"));
   if (records->empty()) return fail(error, located(path, 0, "empty file"));
+  return true;
+}
+
+bool parse_projection(const std::vector<std::string>& fields, const std::string& path, int line,
+                      KittiProjection* out, std::string* error) {
+  if (!expect_field_count(fields, 13, fields[0] + " and 12 numbers of the 3x4 matrix", path, line,
+                          error))
+    return false;
+  double p[12];
+  if (!parse_fields(fields, 1, 12, path, line, p, error)) return false;
+  for (int k = 0; k < 12; ++k) out->P(k / 4, k % 4) = p[k];
+  if (!pinhole_from_matrix(out->P.leftCols<3>(), path, line, &out->camera, error)) return false;
+  out->line = line;
   return true;
 }
 
@@ -58,37 +73,108 @@ bool resolve_paths(const std::string& path, fs::path* sequence_dir, fs::path* ro
 
 }  // namespace
 
+double KittiCalibration::baseline() const {
+  if (!P1.present()) return 0.0;
+  return -P1.P(0, 3) / P1.camera.fx;
+}
+
+bool read_kitti_calibration(const std::string& path, KittiCalibration* calibration,
+                            std::string* error) {
+  std::vector<std::string> lines;
+  if (!read_lines(path, &lines, error)) return false;
+  *calibration = KittiCalibration();
+  for (size_t k = 0; k < lines.size(); ++k) {
+    const std::vector<std::string> fields = split_fields(lines[k]);
+    if (fields.empty()) continue;
+    KittiProjection* target = fields[0] == "P0:"   ? &calibration->P0
+                              : fields[0] == "P1:" ? &calibration->P1
+                                                   : nullptr;
+    if (!target || target->present()) continue;  // the first P0 / P1 counts
+    if (!parse_projection(fields, path, static_cast<int>(k + 1), target, error)) return false;
+  }
+  if (!calibration->P0.present()) return fail(error, located(path, 0, "no 'P0:' line"));
+  const KittiProjection& P1 = calibration->P1;
+  if (P1.present()) {
+    // The right camera of the rectified pair: P1 = K [I | (-b, 0, 0)].
+    if (P1.P(1, 3) != 0.0 || P1.P(2, 3) != 0.0)
+      return fail(error, located(path, P1.line,
+                                 "P1 is not a rectified right camera (P1(1,3) and P1(2,3) "
+                                 "must be 0)"));
+    if (!(calibration->baseline() > 0.0))
+      return fail(error, located(path, P1.line,
+                                 "P1(0,3) = " + std::to_string(P1.P(0, 3)) +
+                                     " gives no positive baseline (expected -fx * b)"));
+  }
+  return true;
+}
+
+bool read_kitti_times(const std::string& path, std::vector<double>* times, std::string* error) {
+  std::vector<std::string> records;
+  if (!read_records(path, &records, error)) return false;
+  times->assign(records.size(), 0.0);
+  for (size_t k = 0; k < records.size(); ++k) {
+    const int line = static_cast<int>(k + 1);
+    const std::vector<std::string> fields = split_fields(records[k]);
+    if (!expect_field_count(fields, 1, "timestamp", path, line, error) ||
+        !parse_fields(fields, 0, 1, path, line, &(*times)[k], error))
+      return false;
+    if (k > 0 && !((*times)[k] > (*times)[k - 1]))
+      return fail(error, located(path, line, "timestamp " + fields[0] +
+                                                 " does not increase on the previous line's"));
+  }
+  return true;
+}
+
+bool read_kitti_poses(const std::string& path, std::vector<KittiPose>* poses,
+                      std::string* error) {
+  std::vector<std::string> records;
+  if (!read_records(path, &records, error)) return false;
+  poses->assign(records.size(), KittiPose());
+  for (size_t k = 0; k < records.size(); ++k) {
+    const int line = static_cast<int>(k + 1);
+    const std::vector<std::string> fields = split_fields(records[k]);
+    double p[12];
+    if (!expect_field_count(fields, 12, "row-major 3x4 camera-to-world [R | t]", path, line,
+                            error) ||
+        !parse_fields(fields, 0, 12, path, line, p, error))
+      return false;
+    Eigen::Matrix3d R;
+    R << p[0], p[1], p[2], p[4], p[5], p[6], p[8], p[9], p[10];
+    if (!to_rotation(R, path, line, &(*poses)[k].R_wc, error)) return false;
+    (*poses)[k].c_w = Eigen::Vector3d(p[3], p[7], p[11]);
+  }
+  return true;
+}
+
+std::string kitti_image_path(const std::string& sequence_dir, int camera, size_t frame) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%06zu.png", frame);
+  return (fs::path(sequence_dir) / ("image_" + std::to_string(camera)) / name).string();
+}
+
+int count_kitti_images(const std::string& sequence_dir, int camera) {
+  const fs::path dir = fs::path(sequence_dir) / ("image_" + std::to_string(camera));
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return -1;
+  int count = 0;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file()) ++count;
+  return count;
+}
+
 bool read_kitti(const std::string& path, Sequence* sequence, std::string* error) {
   fs::path sequence_dir, root;
   if (!resolve_paths(path, &sequence_dir, &root, error)) return false;
   const std::string name = sequence_dir.filename().string();
-  const std::string calib_path = (sequence_dir / "calib.txt").string();
   const std::string times_path = (sequence_dir / "times.txt").string();
   const std::string poses_path = (root / "poses" / (name + ".txt")).string();
 
-  // P0 = K [I | 0] of the rectified left grayscale camera.
-  std::vector<std::string> lines;
-  if (!read_lines(calib_path, &lines, error)) return false;
-  CameraModel camera;
-  bool found_p0 = false;
-  for (size_t k = 0; k < lines.size() && !found_p0; ++k) {
-    const std::vector<std::string> fields = split_fields(lines[k]);
-    if (fields.empty() || fields[0] != "P0:") continue;
-    const int line = static_cast<int>(k + 1);
-    if (!expect_field_count(fields, 13, "P0: and 12 numbers of the 3x4 matrix", calib_path, line,
-                            error))
-      return false;
-    double p[12];
-    if (!parse_fields(fields, 1, 12, calib_path, line, p, error)) return false;
-    Eigen::Matrix3d K;
-    K << p[0], p[1], p[2], p[4], p[5], p[6], p[8], p[9], p[10];
-    if (!pinhole_from_matrix(K, calib_path, line, &camera.pinhole, error)) return false;
-    found_p0 = true;
-  }
-  if (!found_p0) return fail(error, located(calib_path, 0, "no 'P0:' line"));
-
-  std::vector<std::string> times, poses;
-  if (!read_records(times_path, &times, error) || !read_records(poses_path, &poses, error))
+  KittiCalibration calibration;
+  std::vector<double> times;
+  std::vector<KittiPose> poses;
+  if (!read_kitti_calibration((sequence_dir / "calib.txt").string(), &calibration, error) ||
+      !read_kitti_times(times_path, &times, error) ||
+      !read_kitti_poses(poses_path, &poses, error))
     return false;
   if (times.size() != poses.size())
     return fail(error, located(poses_path, 0,
@@ -100,27 +186,11 @@ bool read_kitti(const std::string& path, Sequence* sequence, std::string* error)
   sequence->skipped_frames = 0;
   sequence->frames.assign(times.size(), Frame());
   for (size_t k = 0; k < times.size(); ++k) {
-    const int line = static_cast<int>(k + 1);
     Frame& frame = sequence->frames[k];
-    const std::vector<std::string> time_fields = split_fields(times[k]);
-    if (!expect_field_count(time_fields, 1, "timestamp", times_path, line, error) ||
-        !parse_fields(time_fields, 0, 1, times_path, line, &frame.timestamp, error))
-      return false;
-
-    const std::vector<std::string> pose_fields = split_fields(poses[k]);
-    double p[12];
-    if (!expect_field_count(pose_fields, 12, "row-major 3x4 camera-to-world [R | t]", poses_path,
-                            line, error) ||
-        !parse_fields(pose_fields, 0, 12, poses_path, line, p, error))
-      return false;
-    Eigen::Matrix3d R;
-    R << p[0], p[1], p[2], p[4], p[5], p[6], p[8], p[9], p[10];
-    if (!to_rotation(R, poses_path, line, &frame.R_wc, error)) return false;
-    frame.c_w = Eigen::Vector3d(p[3], p[7], p[11]);
-
-    char image_name[32];
-    std::snprintf(image_name, sizeof(image_name), "%06zu.png", k);
-    frame.image_path = (sequence_dir / "image_0" / image_name).string();
+    frame.timestamp = times[k];
+    frame.R_wc = poses[k].R_wc;
+    frame.c_w = poses[k].c_w;
+    frame.image_path = kitti_image_path(sequence_dir.string(), 0, k);
     std::error_code ec;
     if (!fs::is_regular_file(frame.image_path, ec))
       return fail(error, located(frame.image_path, 0,
@@ -132,6 +202,8 @@ bool read_kitti(const std::string& path, Sequence* sequence, std::string* error)
   const cv::Mat first = cv::imread(sequence->frames.front().image_path, cv::IMREAD_UNCHANGED);
   if (first.empty())
     return fail(error, located(sequence->frames.front().image_path, 0, "cannot decode image"));
+  CameraModel camera;
+  camera.pinhole = calibration.P0.camera;
   camera.pinhole.width = first.cols;
   camera.pinhole.height = first.rows;
   for (Frame& frame : sequence->frames) frame.camera = camera;

@@ -50,6 +50,21 @@ std::vector<std::string> split_fields(const std::string& line) {
   return fields;
 }
 
+std::vector<std::string> split_csv(const std::string& line) {
+  static const char kSpace[] = " \t\r\n\f\v";
+  std::vector<std::string> fields;
+  size_t begin = 0;
+  while (true) {
+    const size_t end = line.find(',', begin);
+    const std::string field = line.substr(begin, end == std::string::npos ? end : end - begin);
+    const size_t first = field.find_first_not_of(kSpace);
+    const size_t last = field.find_last_not_of(kSpace);
+    fields.push_back(first == std::string::npos ? "" : field.substr(first, last - first + 1));
+    if (end == std::string::npos) return fields;
+    begin = end + 1;
+  }
+}
+
 bool is_blank_or_comment(const std::string& line) {
   const size_t first = line.find_first_not_of(" \t\r\n\f\v");
   return first == std::string::npos || line[first] == '#';
@@ -77,6 +92,17 @@ bool parse_int(const std::string& token, int* value) {
       v > std::numeric_limits<int>::max())
     return false;
   *value = static_cast<int>(v);
+  return true;
+}
+
+bool parse_int64(const std::string& token, int64_t* value) {
+  if (token.empty()) return false;
+  const char* begin = token.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const long long v = std::strtoll(begin, &end, 10);
+  if (end != begin + token.size() || errno == ERANGE) return false;
+  *value = static_cast<int64_t>(v);
   return true;
 }
 

@@ -3,6 +3,7 @@
 // Helpers shared by the data set readers for their whitespace-separated text formats. Every error
 // names the file and, where there is one, the 1-based line, compiler style: "file:line: message".
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -25,13 +26,18 @@ bool read_lines(const std::string& path, std::vector<std::string>* lines, std::s
 // Splits a line at whitespace.
 std::vector<std::string> split_fields(const std::string& line);
 
+// Splits a comma-separated line (LaMAR's ", ") and trims whitespace around each field; an empty
+// field stays an empty string.
+std::vector<std::string> split_csv(const std::string& line);
+
 // True for a line that is empty, whitespace only, or a '#' comment (after leading whitespace).
 bool is_blank_or_comment(const std::string& line);
 
 // The whole token must be a finite number ("nan", "inf", "1.5x" and "" are rejected).
 bool parse_double(const std::string& token, double* value);
-// The whole token must be a decimal integer that fits an int.
+// The whole token must be a decimal integer that fits an int (int64_t).
 bool parse_int(const std::string& token, int* value);
+bool parse_int64(const std::string& token, int64_t* value);
 
 // Parses fields[first, first + count) as finite numbers into out[0, count). On failure the error
 // names the field (1-based, as a user counts the columns of the line) and its text.
