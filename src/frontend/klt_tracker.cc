@@ -5,22 +5,9 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "hybrid_vo/frontend/gray_image.h"
+
 namespace hybrid_vo {
-namespace {
-
-cv::Mat to_gray(const cv::Mat& image) {
-  cv::Mat gray;
-  if (image.channels() == 3)
-    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4)
-    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
-  else
-    gray = image;
-  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
-  return gray;
-}
-
-}  // namespace
 
 KltTracker::KltTracker(const KltTrackerOptions& options) : options_(options) {}
 
@@ -36,7 +23,7 @@ std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int6
   std::vector<PointMatch> matches;
   if (ids) ids->clear();
   if (image.empty()) return matches;
-  const cv::Mat gray = to_gray(image);
+  const cv::Mat gray = to_gray8(image);
   if (!previous_.empty() && previous_.size() != gray.size()) reset();
 
   if (!previous_.empty() && !points_.empty()) {

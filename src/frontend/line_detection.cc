@@ -5,20 +5,15 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ximgproc.hpp>
 
+#include "hybrid_vo/frontend/gray_image.h"
+
 namespace hybrid_vo {
 
 std::vector<LineSegment> detect_line_segments(const cv::Mat& image,
                                               const LineDetectionOptions& options) {
   std::vector<LineSegment> segments;
   if (image.empty()) return segments;
-  cv::Mat gray;
-  if (image.channels() == 3)
-    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4)
-    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
-  else
-    gray = image;
-  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
+  const cv::Mat gray = to_gray8(image);
 
   std::vector<cv::Vec4f> raw;
   if (options.detector == LineDetector::kLsd) {

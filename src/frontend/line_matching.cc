@@ -10,23 +10,13 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/line_descriptor.hpp>
 
+#include "hybrid_vo/frontend/gray_image.h"
+
 namespace hybrid_vo {
 namespace {
 
 constexpr int kLbdBytes = 32;   // 256-bit binary LBD per octave
 constexpr int kLbdFloats = 72;  // float LBD per octave: 9 bands x 8 statistics
-
-cv::Mat to_gray8(const cv::Mat& image) {
-  cv::Mat gray;
-  if (image.channels() == 3)
-    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4)
-    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
-  else
-    gray = image;
-  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
-  return gray;
-}
 
 // Bilinear intensity with the border replicated (images of at least 2 x 2 pixels).
 double sample(const cv::Mat& gray, double x, double y) {

@@ -8,20 +8,10 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "hybrid_vo/frontend/gray_image.h"
+
 namespace hybrid_vo {
 namespace {
-
-cv::Mat to_gray8(const cv::Mat& image) {
-  cv::Mat gray;
-  if (image.channels() == 3)
-    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4)
-    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
-  else
-    gray = image;
-  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
-  return gray;
-}
 
 // Exhaustive nearest neighbours in one pass over all pairs: per row of `a` the best and second
 // distances (ratio test), per row of `b` the best row of `a` (mutual check). cv::BFMatcher needs

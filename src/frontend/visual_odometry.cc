@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hybrid_vo/geometry/rotation.h"
+#include "hybrid_vo/frontend/gray_image.h"
 
 namespace hybrid_vo {
 namespace {
@@ -14,18 +15,6 @@ namespace {
 double ms_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
-}
-
-cv::Mat to_gray(const cv::Mat& image) {
-  cv::Mat gray;
-  if (image.channels() == 3)
-    cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4)
-    cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
-  else
-    gray = image;
-  if (gray.depth() != CV_8U) gray.convertTo(gray, CV_8U);
-  return gray;
 }
 
 bool uses_vps(const RelativePoseEstimatorOptions& options) {
@@ -108,7 +97,7 @@ void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::M
     }
     std::vector<char> valid;
     const std::vector<Eigen::Vector3d> X = stereo_points(
-        gray, to_gray(input.right_image), pixels, input.camera.pinhole, input.baseline_m, &valid,
+        gray, to_gray8(input.right_image), pixels, input.camera.pinhole, input.baseline_m, &valid,
         options_.stereo);
     for (size_t i = 0; i < ids.size(); ++i)
       if (valid[i]) keyframe_.points3d[ids[i]] = X[i];
@@ -131,7 +120,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     was_reset = true;
   }
   last_stamp_ = input.stamp;
-  const cv::Mat gray = to_gray(input.image);
+  const cv::Mat gray = to_gray8(input.image);
 
   // Features of this frame.
   std::map<int64_t, Eigen::Vector2d> points;

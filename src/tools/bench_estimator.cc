@@ -16,6 +16,7 @@
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/synthetic/manhattan_scene.h"
+#include "statistics.h"
 
 namespace hybrid_vo {
 namespace {
@@ -82,11 +83,7 @@ bool parse(int argc, char** argv, Arguments* a) {
   return true;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+using hybrid_vo::tools::median;
 
 struct Samples {
   std::vector<double> ms, iterations, rot, trans, recall;

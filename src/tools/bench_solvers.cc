@@ -19,6 +19,7 @@
 #include "hybrid_vo/solvers/minimal_solver.h"
 #include "hybrid_vo/synthetic/minimal_instances.h"
 #include "plot.h"
+#include "statistics.h"
 
 #ifdef HYBRID_VO_HAVE_OPENGV
 #include <opengv/relative_pose/CentralRelativeAdapter.hpp>
@@ -92,11 +93,7 @@ bool parse(int argc, char** argv, Arguments* args) {
   return true;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+using hybrid_vo::tools::median;
 
 struct Row {
   SolverId id = SolverId::k5pt;

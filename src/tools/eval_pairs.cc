@@ -19,6 +19,7 @@
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/lines/two_view.h"
 #include "tool_args.h"
+#include "statistics.h"
 
 namespace hybrid_vo {
 namespace {
@@ -129,11 +130,7 @@ bool parse(int argc, char** argv, Arguments* a) {
   return true;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+using hybrid_vo::tools::median;
 
 struct MethodStats {
   std::vector<double> errors, estimator_ms;

@@ -18,6 +18,7 @@
 #include "hybrid_vo/geometry/pose_error.h"
 #include "plot.h"
 #include "trajectory.h"
+#include "statistics.h"
 
 namespace {
 
@@ -34,11 +35,7 @@ void usage(const char* program) {
                "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n";
 }
 
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+using hybrid_vo::tools::median;
 
 StampedPose from_transform(double stamp, const geometry_msgs::Transform& t) {
   StampedPose p;
@@ -265,8 +262,8 @@ int main(int argc, char** argv) {
   if (!total_ms.empty())
     std::printf("# per frame (median): front end %.1f ms, estimator %.1f ms, total %.1f ms = %.1f "
                 "frames/s\n",
-                median_of(frontend_ms), median_of(estimator_ms), median_of(total_ms),
-                1000.0 / std::max(1e-3, median_of(total_ms)));
+                median(frontend_ms), median(estimator_ms), median(total_ms),
+                1000.0 / std::max(1e-3, median(total_ms)));
   std::printf("summary: pairs=%zu auc5=%.2f auc10=%.2f auc20=%.2f rpe_trans=%.4f rpe_rot_deg=%.4f "
               "ate=%.4f\n",
               errors.size(), 100.0 * hybrid_vo::pose_auc(errors, 5.0),

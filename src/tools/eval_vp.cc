@@ -14,6 +14,7 @@
 
 #include "hybrid_vo/frontend/line_detection.h"
 #include "hybrid_vo/lines/vp_detection.h"
+#include "statistics.h"
 
 namespace {
 
@@ -74,11 +75,7 @@ bool read_rows(const std::string& path, size_t columns, std::vector<std::vector<
   return true;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+using hybrid_vo::tools::median;
 
 }  // namespace
 
