@@ -130,6 +130,10 @@ HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,
     }
   };
   refresh();
+  const bool reserve_five_point =
+      active.size() > 1 && std::find(active.begin(), active.end(),
+                                     static_cast<int>(SolverId::k5pt)) != active.end();
+  const double five_point_share = std::clamp(options.five_point_share, 0.0, 1.0);
   const int valid_lines = static_cast<int>(
       std::count(problem.line_valid.begin(), problem.line_valid.end(), static_cast<char>(1)));
 
@@ -148,11 +152,14 @@ HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,
       if (log_miss <= log_miss_target) break;
     }
     out.iterations = iteration + 1;
-    const double r = unit(*rng) * cumulative.back();
-    const size_t a = std::min<size_t>(
-        std::lower_bound(cumulative.begin(), cumulative.end(), r) - cumulative.begin(),
-        active.size() - 1);
-    const int s = active[a];
+    int s = static_cast<int>(SolverId::k5pt);
+    if (!reserve_five_point || !(unit(*rng) < five_point_share)) {
+      const double r = unit(*rng) * cumulative.back();
+      const size_t a = std::min<size_t>(
+          std::lower_bound(cumulative.begin(), cumulative.end(), r) - cumulative.begin(),
+          active.size() - 1);
+      s = active[a];
+    }
     out.solvers[s].sampled++;
     if (!sampler.draw(static_cast<SolverId>(s), &sample)) continue;
     drawn[s]++;

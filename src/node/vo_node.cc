@@ -134,6 +134,12 @@ void VoNode::load_parameters() {
   o.estimator.estimator.ransac.point_threshold_px = pnh_.param("point_threshold_px", 1.0);
   o.estimator.estimator.ransac.vp_threshold_deg = pnh_.param("vp_threshold_deg", 2.0);
   o.estimator.vp_detection.inlier_threshold_px = pnh_.param("vp_inlier_threshold_px", 2.0);
+  o.estimator.vp_detection.min_inliers =
+      pnh_.param("vp_min_inliers", o.estimator.vp_detection.min_inliers);
+  if (o.estimator.vp_detection.min_inliers < 2) {
+    ROS_WARN("hybrid_vo: vp_min_inliers must be >= 2 (a VP needs two segments), using 15");
+    o.estimator.vp_detection.min_inliers = 15;
+  }
   o.use_vp_tracker = pnh_.param("vp_tracker", true);
 }
 

@@ -52,7 +52,8 @@ void usage(const char* program) {
       << "  Pairs are frames i and i+K (superglue: the pairs file, images under --images).\n"
       << "  Prints method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms (AUC in %),\n"
       << "  one row per preset plus opencv_usac_magsac (findEssentialMat + recoverPose on the same\n"
-      << "  points). --vp-modes adds the VP ablation: standard, joint, joint+refined.\n"
+      << "  points, seeded like the presets). --vp-modes adds the VP ablation: standard, joint,\n"
+      << "  joint+refined.\n"
       << "  --runs N repeats every estimator N times per pair with different seeds and pools the\n"
       << "  errors, so that one unlucky RANSAC run does not decide a small data set's AUC.\n";
 }
@@ -171,26 +172,42 @@ class FeatureCache {
   std::map<std::string, Entry> cache_;
 };
 
-// OpenCV's USAC_MAGSAC essential matrix plus recoverPose, on normalised points when the two
-// cameras differ (its API takes one K).
+cv::Mat intrinsics(const PinholeCamera& c) {
+  return (cv::Mat_<double>(3, 3) << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0);
+}
+
+// OpenCV's USAC_MAGSAC essential matrix plus recoverPose. The call is the one a user makes (pixels
+// and K, threshold in pixels), with the settings findEssentialMat(..., USAC_MAGSAC, ...) uses,
+// except that the seed is ours: the flag version always seeds 0, so --runs would repeat one run.
 double run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const PinholeCamera& c2,
-                  const RelativePose& truth, double threshold_px, double* ms) {
+                  const RelativePose& truth, double threshold_px, uint64_t seed, double* ms) {
   const auto start = std::chrono::steady_clock::now();
   double error = kFailed;
   if (m.points.size() >= 5) {
-    std::vector<cv::Point2d> p1, p2;
+    std::vector<cv::Point2d> px1, px2, n1, n2;
     for (const PointMatch& p : m.points) {
+      px1.emplace_back(p.x1.x(), p.x1.y());
+      px2.emplace_back(p.x2.x(), p.x2.y());
       const Eigen::Vector2d a = c1.normalize(p.x1), b = c2.normalize(p.x2);
-      p1.emplace_back(a.x(), a.y());
-      p2.emplace_back(b.x(), b.y());
+      n1.emplace_back(a.x(), a.y());
+      n2.emplace_back(b.x(), b.y());
     }
-    const double f = 0.5 * (c1.mean_focal() + c2.mean_focal());
+    cv::UsacParams params;
+    params.confidence = 0.999;
+    params.maxIterations = 1000;
+    params.score = cv::SCORE_METHOD_MAGSAC;
+    params.loMethod = cv::LOCAL_OPTIM_SIGMA;
+    params.loSampleSize = 50;
+    params.loIterations = 10;
+    params.sampler = cv::SAMPLING_UNIFORM;
+    params.threshold = threshold_px;
+    params.randomGeneratorState = static_cast<int>(seed & 0x7fffffff);
     cv::Mat mask;
-    const cv::Mat E = cv::findEssentialMat(p1, p2, cv::Mat::eye(3, 3, CV_64F), cv::USAC_MAGSAC,
-                                           0.999, threshold_px / f, mask);
+    const cv::Mat E = cv::findEssentialMat(px1, px2, intrinsics(c1), intrinsics(c2), cv::noArray(),
+                                           cv::noArray(), mask, params);
     if (E.rows == 3 && E.cols == 3) {
       cv::Mat R, t;
-      if (cv::recoverPose(E, p1, p2, cv::Mat::eye(3, 3, CV_64F), R, t, mask) > 0) {
+      if (cv::recoverPose(E, n1, n2, cv::Mat::eye(3, 3, CV_64F), R, t, mask) > 0) {
         Eigen::Matrix3d Re;
         Eigen::Vector3d te;
         for (int r = 0; r < 3; ++r) {
@@ -315,7 +332,8 @@ int main(int argc, char** argv) {
     for (int run = 0; args.opencv && run < args.runs; ++run) {
       double ms = 0.0;
       const double e = run_opencv(matches, c0.pinhole, c1.pinhole, truth,
-                                 args.point_threshold > 0.0 ? args.point_threshold : 1.0, &ms);
+                                 args.point_threshold > 0.0 ? args.point_threshold : 1.0,
+                                 args.seed + p + 1000003ull * run, &ms);
       stats["opencv_usac_magsac"].errors.push_back(e);
       stats["opencv_usac_magsac"].estimator_ms.push_back(ms);
       if (csv)
