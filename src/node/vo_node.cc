@@ -134,11 +134,12 @@ void VoNode::load_parameters() {
   o.estimator.estimator.ransac.point_threshold_px = pnh_.param("point_threshold_px", 1.0);
   o.estimator.estimator.ransac.vp_threshold_deg = pnh_.param("vp_threshold_deg", 2.0);
   o.estimator.vp_detection.inlier_threshold_px = pnh_.param("vp_inlier_threshold_px", 2.0);
-  o.estimator.vp_detection.min_inliers =
-      pnh_.param("vp_min_inliers", o.estimator.vp_detection.min_inliers);
+  // 6, not the pair tools' 15: the video front end's FLD segments are fewer and shorter, and the
+  // VP tracker already keeps only VPs that persist (KITTI and demo AUC@10 +1.5 and +1.2 at 6).
+  o.estimator.vp_detection.min_inliers = pnh_.param("vp_min_inliers", 6);
   if (o.estimator.vp_detection.min_inliers < 2) {
-    ROS_WARN("hybrid_vo: vp_min_inliers must be >= 2 (a VP needs two segments), using 15");
-    o.estimator.vp_detection.min_inliers = 15;
+    ROS_WARN("hybrid_vo: vp_min_inliers must be >= 2 (a VP needs two segments), using 6");
+    o.estimator.vp_detection.min_inliers = 6;
   }
   o.use_vp_tracker = pnh_.param("vp_tracker", true);
 }

@@ -13,8 +13,9 @@ struct TwoViewOptions {
   VpDetectionOptions vp_detection;
 
   // VPs for pose estimation need more support than the detector's default: on TUM, VP matches
-  // with fewer than 15 segments agreed with the ground-truth rotation (2 degrees) in under half
-  // of the cases, and they cost the hybrid presets up to 10 AUC@10 points (README "Tuning").
+  // with fewer than 20 segments agreed with the ground-truth rotation (2 degrees) in under half
+  // of the cases, and they cost the hybrid presets up to 8 AUC@10 points (README, pair
+  // evaluation). The VO node sets its own (vp_min_inliers).
   TwoViewOptions() { vp_detection.min_inliers = 15; }
 };
 
