@@ -85,6 +85,27 @@ TEST(HybridEstimator, LinesCarryTheRotationWithFewPoints) {
   RecordProperty("median_rot_hybrid_deg", std::to_string(median(hybrid.rot)));
 }
 
+// The hybrid keeps searching the point-only solution: half of its draws go to the 5-point
+// solver however much the adaptive selection favours the small VP samples, and none when off.
+TEST(HybridEstimator, FivePointSolverKeepsItsShareOfTheDraws) {
+  std::mt19937_64 rng(41);
+  const ManhattanScene scene = generate_manhattan_scene(rng, hard_scene());
+  RelativePoseEstimatorOptions options;
+  ASSERT_TRUE(preset_options("hybrid", &options));
+  options.ransac.min_iterations = 400;
+  const int five_point = static_cast<int>(SolverId::k5pt);
+  const RelativePoseEstimate est =
+      estimate_relative_pose(scene.camera1, scene.camera2, scene.matches, options);
+  ASSERT_EQ(est.status, EstimationStatus::kOk);
+  EXPECT_GE(est.solvers[five_point].sampled, 0.4 * est.iterations);
+
+  options.ransac.five_point_share = 0.0;
+  const RelativePoseEstimate adaptive =
+      estimate_relative_pose(scene.camera1, scene.camera2, scene.matches, options);
+  ASSERT_EQ(adaptive.status, EstimationStatus::kOk);
+  EXPECT_LT(adaptive.solvers[five_point].sampled, 0.4 * adaptive.iterations);
+}
+
 TEST(HybridEstimator, InlierMasksMatchTheTruth) {
   std::mt19937_64 rng(31);
   const ManhattanScene scene = generate_manhattan_scene(rng, hard_scene());

@@ -10,12 +10,12 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/synthetic/manhattan_scene.h"
+#include "opencv_baseline.h"
 #include "statistics.h"
 
 namespace hybrid_vo {
@@ -104,43 +104,20 @@ double recall(const std::vector<char>& estimated, const std::vector<bool>& truth
   return inliers > 0 ? static_cast<double>(found) / inliers : 0.0;
 }
 
-// cv::findEssentialMat with USAC_MAGSAC plus cv::recoverPose on the same point matches.
+// OpenCV's USAC_MAGSAC plus recoverPose (opencv_baseline.h) on the same point matches; recall is
+// measured on MAGSAC's own inliers.
 void run_opencv(const ManhattanScene& scene, double threshold_px, Samples* out) {
-  std::vector<cv::Point2d> p1, p2;
-  for (const PointMatch& m : scene.matches.points) {
-    p1.emplace_back(m.x1.x(), m.x1.y());
-    p2.emplace_back(m.x2.x(), m.x2.y());
-  }
-  const PinholeCamera& c = scene.camera1;
-  const cv::Matx33d K(c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
-  cv::Mat mask;
   const auto start = std::chrono::steady_clock::now();
-  const cv::Mat E = cv::findEssentialMat(p1, p2, K, cv::USAC_MAGSAC, 0.999, threshold_px, mask);
-  cv::Mat R, t;
-  int good = 0;
-  // Recall is measured on MAGSAC's own inliers; recoverPose then prunes its copy by cheirality.
-  const cv::Mat ransac_mask = mask.clone();
-  if (E.rows == 3 && E.cols == 3) good = cv::recoverPose(E, p1, p2, K, R, t, mask);
+  const tools::OpenCvPose result = tools::opencv_usac_magsac(
+      scene.matches.points, scene.camera1, scene.camera2, threshold_px, 0);
   out->ms.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   out->iterations.push_back(NAN);
-  std::vector<char> inliers(p1.size(), 0);
-  if (good > 0) {
-    for (size_t i = 0; i < p1.size(); ++i)
-      inliers[i] = ransac_mask.at<uchar>(static_cast<int>(i)) != 0;
-    Eigen::Matrix3d Re;
-    Eigen::Vector3d te;
-    for (int r = 0; r < 3; ++r) {
-      te(r) = t.at<double>(r);
-      for (int k = 0; k < 3; ++k) Re(r, k) = R.at<double>(r, k);
-    }
-    out->rot.push_back(rotation_error(Re, scene.truth.R) * 180.0 / M_PI);
-    out->trans.push_back(translation_error(te, scene.truth.t) * 180.0 / M_PI);
-  } else {
-    out->rot.push_back(180.0);
-    out->trans.push_back(180.0);
-  }
-  out->recall.push_back(recall(inliers, scene.point_inlier));
+  out->rot.push_back(result.ok ? rotation_error(result.pose.R, scene.truth.R) * 180.0 / M_PI
+                               : 180.0);
+  out->trans.push_back(result.ok ? translation_error(result.pose.t, scene.truth.t) * 180.0 / M_PI
+                                 : 180.0);
+  out->recall.push_back(recall(result.inliers, scene.point_inlier));
 }
 
 }  // namespace

@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -18,6 +17,7 @@
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/lines/two_view.h"
+#include "opencv_baseline.h"
 #include "tool_args.h"
 #include "statistics.h"
 
@@ -188,54 +188,13 @@ class FeatureCache {
   std::map<std::string, Entry> cache_;
 };
 
-cv::Mat intrinsics(const PinholeCamera& c) {
-  return (cv::Mat_<double>(3, 3) << c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0);
-}
-
-// OpenCV's USAC_MAGSAC essential matrix plus recoverPose. The call is the one a user makes (pixels
-// and K, threshold in pixels), with the settings findEssentialMat(..., USAC_MAGSAC, ...) uses,
-// except that the seed is ours: the flag version always seeds 0, so --runs would repeat one run.
+// OpenCV's USAC_MAGSAC plus recoverPose (opencv_baseline.h) on the same points.
 double run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const PinholeCamera& c2,
                   const RelativePose& truth, double threshold_px, uint64_t seed, double* ms) {
   const auto start = std::chrono::steady_clock::now();
-  double error = kFailed;
-  if (m.points.size() >= 5) {
-    std::vector<cv::Point2d> px1, px2, n1, n2;
-    for (const PointMatch& p : m.points) {
-      px1.emplace_back(p.x1.x(), p.x1.y());
-      px2.emplace_back(p.x2.x(), p.x2.y());
-      const Eigen::Vector2d a = c1.normalize(p.x1), b = c2.normalize(p.x2);
-      n1.emplace_back(a.x(), a.y());
-      n2.emplace_back(b.x(), b.y());
-    }
-    cv::UsacParams params;
-    params.confidence = 0.999;
-    params.maxIterations = 1000;
-    params.score = cv::SCORE_METHOD_MAGSAC;
-    params.loMethod = cv::LOCAL_OPTIM_SIGMA;
-    params.loSampleSize = 50;
-    params.loIterations = 10;
-    params.sampler = cv::SAMPLING_UNIFORM;
-    params.threshold = threshold_px;
-    params.randomGeneratorState = static_cast<int>(seed & 0x7fffffff);
-    cv::Mat mask;
-    const cv::Mat E = cv::findEssentialMat(px1, px2, intrinsics(c1), intrinsics(c2), cv::noArray(),
-                                           cv::noArray(), mask, params);
-    if (E.rows == 3 && E.cols == 3) {
-      cv::Mat R, t;
-      if (cv::recoverPose(E, n1, n2, cv::Mat::eye(3, 3, CV_64F), R, t, mask) > 0) {
-        Eigen::Matrix3d Re;
-        Eigen::Vector3d te;
-        for (int r = 0; r < 3; ++r) {
-          te(r) = t.at<double>(r);
-          for (int k = 0; k < 3; ++k) Re(r, k) = R.at<double>(r, k);
-        }
-        error = pose_error(RelativePose(Re, te), truth) * kDeg;
-      }
-    }
-  }
+  const tools::OpenCvPose result = tools::opencv_usac_magsac(m.points, c1, c2, threshold_px, seed);
   *ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return error;
+  return result.ok ? pose_error(result.pose, truth) * kDeg : kFailed;
 }
 
 void print_row(const std::string& method, const MethodStats& s, double frontend_ms) {
