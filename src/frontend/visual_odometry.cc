@@ -1,6 +1,7 @@
 #include "hybrid_vo/frontend/visual_odometry.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -12,15 +13,29 @@
 namespace hybrid_vo {
 namespace {
 
-double ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
-
 bool uses_vps(const RelativePoseEstimatorOptions& options) {
   for (const SolverInfo& info : solver_table())
     if (options.ransac.enabled[static_cast<int>(info.id)] && info.num_vps > 0) return true;
   return false;
+}
+
+// Metric 3D points (left camera) of a rectified stereo pair's features, by id.
+std::map<int64_t, Eigen::Vector3d> stereo_points_by_id(
+    const cv::Mat& left, const cv::Mat& right, const std::map<int64_t, Eigen::Vector2d>& points,
+    const PinholeCamera& camera, double baseline_m, const StereoOptions& options) {
+  std::map<int64_t, Eigen::Vector3d> points3d;
+  std::vector<int64_t> ids;
+  std::vector<Eigen::Vector2d> pixels;
+  for (const auto& [id, p] : points) {
+    ids.push_back(id);
+    pixels.push_back(p);
+  }
+  std::vector<char> valid;
+  const std::vector<Eigen::Vector3d> X =
+      stereo_points(left, to_gray8(right), pixels, camera, baseline_m, &valid, options);
+  for (size_t i = 0; i < ids.size(); ++i)
+    if (valid[i]) points3d[ids[i]] = X[i];
+  return points3d;
 }
 
 }  // namespace
@@ -51,7 +66,10 @@ const char* to_string(VoStatus status) {
 }
 
 VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
-    : options_(options), klt_(options.klt), vp_tracker_(options.vp_tracker) {
+    : options_(options),
+      worker_(std::make_unique<WorkerThread>(options.concurrent)),
+      klt_(options.klt),
+      vp_tracker_(options.vp_tracker) {
   if (options_.use_vp_tracker) {
     // The tracker feeds d1 from directions averaged over many frames: trust them as given (they
     // pin the rotation to the tracked Manhattan frame, which stops rotational drift) rather than
@@ -60,6 +78,8 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
     options_.estimator.estimator.refinement.vp_weight = options_.tracked_vp_weight;
   }
 }
+
+VisualOdometry::~VisualOdometry() = default;
 
 void VisualOdometry::reset() {
   klt_.reset();
@@ -71,9 +91,10 @@ void VisualOdometry::reset() {
   tracker_seeded_ = false;
 }
 
-void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
+void VisualOdometry::make_keyframe(const VisualOdometryInput& input,
                                    const std::map<int64_t, Eigen::Vector2d>& points,
-                                   ImageFeatures features) {
+                                   ImageFeatures features,
+                                   std::map<int64_t, Eigen::Vector3d> points3d) {
   keyframe_ = Keyframe();
   keyframe_.valid = true;
   keyframe_.stamp = input.stamp;
@@ -88,20 +109,7 @@ void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::M
   keyframe_.points_undistorted = input.external.has_points && input.external.points_undistorted;
   keyframe_.lines_undistorted = input.external.has_lines && input.external.lines_undistorted;
   // Stereo: metric 3D points of the keyframe's features, for the scale of the next motion.
-  if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
-    std::vector<int64_t> ids;
-    std::vector<Eigen::Vector2d> pixels;
-    for (const auto& [id, p] : points) {
-      ids.push_back(id);
-      pixels.push_back(p);
-    }
-    std::vector<char> valid;
-    const std::vector<Eigen::Vector3d> X = stereo_points(
-        gray, to_gray8(input.right_image), pixels, input.camera.pinhole, input.baseline_m, &valid,
-        options_.stereo);
-    for (size_t i = 0; i < ids.size(); ++i)
-      if (valid[i]) keyframe_.points3d[ids[i]] = X[i];
-  }
+  keyframe_.points3d = std::move(points3d);
 }
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
@@ -121,10 +129,20 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   }
   last_stamp_ = input.stamp;
   const cv::Mat gray = to_gray8(input.image);
+  StageTimings& times = r.stages;
 
-  // Features of this frame.
+  // Features of this frame: the segments on the second thread while this one does the points.
   std::map<int64_t, Eigen::Vector2d> points;
   ImageFeatures features;
+  WorkerJob lines_job;
+  if (options_.use_lines && !input.external.has_lines) {
+    lines_job = worker_->submit([&] {
+      const auto lines_start = std::chrono::steady_clock::now();
+      features.lines = detect_line_features(gray, options_.features.lines);
+      times.lines_ms = ms_since(lines_start);
+    });
+  }
+  const auto points_start = std::chrono::steady_clock::now();
   if (input.external.has_points) {
     for (size_t i = 0; i < input.external.points.size() && i < input.external.point_ids.size(); ++i)
       if (all_finite(input.external.points[i]))
@@ -139,11 +157,27 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       points[static_cast<int64_t>(i)] = Eigen::Vector2d(features.points.keypoints[i].pt.x,
                                                         features.points.keypoints[i].pt.y);
   }
-  if (options_.use_lines && !input.external.has_lines)
-    features.lines = detect_line_features(gray, options_.features.lines);
+  times.points_ms = ms_since(points_start);
+  // Stereo matching of this frame's points, for the scale of the next motion: on the second
+  // thread while this one matches and estimates. Skipped when the frame turns out not to be kept
+  // before it starts.
+  std::map<int64_t, Eigen::Vector3d> points3d;
+  std::atomic<bool> skip_stereo{false};
+  WorkerJob stereo_job;
+  if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
+    stereo_job = worker_->submit([&] {
+      if (skip_stereo) return;
+      const auto stereo_start = std::chrono::steady_clock::now();
+      points3d = stereo_points_by_id(gray, input.right_image, points, input.camera.pinhole,
+                                     input.baseline_m, options_.stereo);
+      times.stereo_ms = ms_since(stereo_start);
+    });
+  }
+  lines_job.get();
 
   if (!keyframe_.valid) {
-    make_keyframe(input, gray, points, std::move(features));
+    stereo_job.get();
+    make_keyframe(input, points, std::move(features), std::move(points3d));
     r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
     r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
     r.reference_stamp = input.stamp;
@@ -174,7 +208,14 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       if (it != keyframe_.external_lines.end()) m.lines.push_back({it->second, input.external.lines[i]});
     }
   } else if (options_.use_lines) {
-    m.lines = match_line_features(keyframe_.features.lines, features.lines, options_.features.lines);
+    const auto matching_start = std::chrono::steady_clock::now();
+    m.lines = options_.track_lines
+                  ? track_line_segments(keyframe_.features.lines, features.lines, m.points,
+                                        options_.features.lines, options_.line_tracking,
+                                        &r.line_tracking)
+                  : match_line_features(keyframe_.features.lines, features.lines,
+                                        options_.features.lines);
+    times.line_matching_ms = ms_since(matching_start);
   }
   r.num_point_matches = static_cast<int>(m.points.size());
   r.num_line_matches = static_cast<int>(m.lines.size());
@@ -182,7 +223,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
 
   if (r.num_point_matches < options_.min_point_matches &&
       r.num_line_matches < options_.min_line_matches) {
-    make_keyframe(input, gray, points, std::move(features));
+    stereo_job.get();
+    make_keyframe(input, points, std::move(features), std::move(points3d));
     r.status = VoStatus::kTooFewFeatures;
     r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
@@ -196,6 +238,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     if (motion[motion.size() / 2] < options_.min_parallax_px) {
       r.status = VoStatus::kLowParallax;
       r.message = "median motion " + std::to_string(motion[motion.size() / 2]) + " px";
+      skip_stereo = true;
+      stereo_job.wait();
       r.total_ms = ms_since(start);
       return r;
     }
@@ -217,6 +261,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     if (!lines_done) std::swap(distorted.lines, m.lines);
   }
   TwoViewOptions estimator = options_.estimator;
+  const auto vps_start = std::chrono::steady_clock::now();
   if (uses_vps(estimator.estimator) && !m.lines.empty()) {
     VpDetectionOptions vp_options = estimator.vp_detection;
     const MatchedVps vps = estimator.joint_vp_detection
@@ -238,8 +283,11 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       r.vp_track_ids = vp_tracker_.refine_matches(keyframe_.R_wc, &m.vps);
     }
   }
+  times.vps_ms = ms_since(vps_start);
   estimator.detect_vps = false;  // detected above (or unwanted)
+  const auto ransac_start = std::chrono::steady_clock::now();
   r.estimate = estimate_two_view(keyframe_.camera.pinhole, input.camera.pinhole, m, estimator);
+  times.ransac_ms = ms_since(ransac_start);
   r.estimate.vps.matches = m.vps;
   r.estimate.vps.labels = m.line_vp;
   r.estimator_ms = ms_since(estimate_start);
@@ -247,6 +295,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   if (est.status != EstimationStatus::kOk) {
     r.status = VoStatus::kNoPose;
     r.message = std::string("estimator: ") + hybrid_vo::to_string(est.status);
+    skip_stereo = true;
+    stereo_job.wait();
     r.total_ms = ms_since(start);
     return r;
   }
@@ -287,7 +337,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     }
     vp_tracker_.update(R_wc_, d2, weights);
   }
-  make_keyframe(input, gray, points, std::move(features));
+  stereo_job.get();
+  make_keyframe(input, points, std::move(features), std::move(points3d));
   r.status = VoStatus::kOk;
   r.message = "ok";
   r.total_ms = ms_since(start);
