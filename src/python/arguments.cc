@@ -225,14 +225,8 @@ PinholeCamera camera_argument(py::handle value, const std::string& name,
 }
 
 py::dict camera_to_dict(const PinholeCamera& camera) {
-  py::dict d;
-  d["fx"] = camera.fx;
-  d["fy"] = camera.fy;
-  d["cx"] = camera.cx;
-  d["cy"] = camera.cy;
-  d["width"] = camera.width;
-  d["height"] = camera.height;
-  return d;
+  return py::dict("fx"_a = camera.fx, "fy"_a = camera.fy, "cx"_a = camera.cx, "cy"_a = camera.cy,
+                  "width"_a = camera.width, "height"_a = camera.height);
 }
 
 py::array_t<bool> to_bool_array(const std::vector<char>& mask) {
@@ -256,25 +250,17 @@ py::array_t<int64_t> to_int_array(const std::vector<int>& values) {
 }
 
 py::array_t<double> points_to_array(const std::vector<Eigen::Vector2d>& points) {
-  py::array_t<double> a({static_cast<py::ssize_t>(points.size()), py::ssize_t{2}});
-  double* out = a.mutable_data();
-  for (const Eigen::Vector2d& p : points) *out++ = p.x(), *out++ = p.y();
-  return a;
+  return rows_to_array<double, 2>(points, [](const Eigen::Vector2d& p) { return p; });
 }
 
 py::array_t<double> segments_to_array(const std::vector<LineSegment>& segments) {
-  py::array_t<double> a({static_cast<py::ssize_t>(segments.size()), py::ssize_t{4}});
-  double* out = a.mutable_data();
-  for (const LineSegment& s : segments)
-    *out++ = s.p1.x(), *out++ = s.p1.y(), *out++ = s.p2.x(), *out++ = s.p2.y();
-  return a;
+  return rows_to_array<double, 4>(segments, [](const LineSegment& s) {
+    return Eigen::Vector4d(s.p1.x(), s.p1.y(), s.p2.x(), s.p2.y());
+  });
 }
 
 py::array_t<double> directions_to_array(const std::vector<Eigen::Vector3d>& directions) {
-  py::array_t<double> a({static_cast<py::ssize_t>(directions.size()), py::ssize_t{3}});
-  double* out = a.mutable_data();
-  for (const Eigen::Vector3d& d : directions) *out++ = d.x(), *out++ = d.y(), *out++ = d.z();
-  return a;
+  return rows_to_array<double, 3>(directions, [](const Eigen::Vector3d& d) { return d; });
 }
 
 py::tuple pose_to_tuple(const RelativePose& pose) {

@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <string>
 #include <vector>
@@ -109,6 +110,17 @@ py::array_t<double> to_array(const Eigen::MatrixBase<Derived>& m) {
 py::array_t<bool> to_bool_array(const std::vector<char>& mask);
 py::array_t<bool> to_bool_array(const std::vector<bool>& mask);
 py::array_t<int64_t> to_int_array(const std::vector<int>& values);
+// An N x cols array whose row i is row(items[i]), an Eigen vector of `cols` values.
+template <typename Scalar, int Cols, typename T, typename Row>
+py::array_t<Scalar> rows_to_array(const std::vector<T>& items, Row row) {
+  py::array_t<Scalar> a({static_cast<py::ssize_t>(items.size()), py::ssize_t{Cols}});
+  Scalar* out = a.mutable_data();
+  for (const T& item : items) {
+    const Eigen::Matrix<Scalar, Cols, 1> values = row(item);
+    out = std::copy(values.data(), values.data() + Cols, out);
+  }
+  return a;
+}
 py::array_t<double> points_to_array(const std::vector<Eigen::Vector2d>& points);
 py::array_t<double> segments_to_array(const std::vector<LineSegment>& segments);
 py::array_t<double> directions_to_array(const std::vector<Eigen::Vector3d>& directions);

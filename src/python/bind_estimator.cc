@@ -127,20 +127,17 @@ Estimate estimate(py::handle camera1, py::handle camera2, py::handle points1, py
   return out;
 }
 
+// Derived point matches as rows (x1, y1, x2, y2), and their sources as rows (first, second).
 py::array_t<double> derived_points(const std::vector<DerivedPoint>& derived) {
-  py::array_t<double> a({static_cast<py::ssize_t>(derived.size()), py::ssize_t{4}});
-  double* out = a.mutable_data();
-  for (const DerivedPoint& d : derived)
-    *out++ = d.match.x1.x(), *out++ = d.match.x1.y(), *out++ = d.match.x2.x(),
-    *out++ = d.match.x2.y();
-  return a;
+  return rows_to_array<double, 4>(derived, [](const DerivedPoint& d) {
+    return Eigen::Vector4d(d.match.x1.x(), d.match.x1.y(), d.match.x2.x(), d.match.x2.y());
+  });
 }
 
 py::array_t<int64_t> derived_sources(const std::vector<DerivedPoint>& derived) {
-  py::array_t<int64_t> a({static_cast<py::ssize_t>(derived.size()), py::ssize_t{2}});
-  int64_t* out = a.mutable_data();
-  for (const DerivedPoint& d : derived) *out++ = d.first, *out++ = d.second;
-  return a;
+  return rows_to_array<int64_t, 2>(derived, [](const DerivedPoint& d) {
+    return Eigen::Matrix<int64_t, 2, 1>(d.first, d.second);
+  });
 }
 
 std::string repr(const Estimate& e) {

@@ -50,207 +50,164 @@ std::string solver_doc(SolverId id, const std::string& signature, const std::str
 const char* kVpSign =
     "With vp_sign_known, v2 = +R v1; otherwise the sign v2 = -R v1 is tried too.\n";
 
+// Binds the solver `id` under its C++ name: `solve` reads the Python arguments (named by
+// `names`) and runs the C++ function; the docstring comes from solver_doc.
+template <typename... Handles, typename... Names>
+void def_solver(py::module_& m, SolverId id, const std::string& signature,
+                const std::string& details, void (*solve)(RelativePoses*, Handles...),
+                Names... names) {
+  m.def(
+      solver_info(id).function,
+      [solve](Handles... arguments) {
+        RelativePoses poses;
+        solve(&poses, arguments...);
+        return poses_to_list(poses);
+      },
+      names..., solver_doc(id, signature, details).c_str());
+}
+
+using H = py::handle;
+
 }  // namespace
 
 void bind_solvers(py::module_& m) {
-  m.def(
-      "relpose_5pt",
-      [](py::handle x1, py::handle x2) {
-        RelativePoses poses;
-        relpose_5pt(points_argument<5>(x1, "x1"), points_argument<5>(x2, "x2"), &poses);
-        return poses_to_list(poses);
+  def_solver(
+      m, SolverId::k5pt, "(x1, x2)",
+      "x1, x2: 5 x 2 point matches. Nister's five-point essential matrix, decomposed.\n",
+      +[](RelativePoses* p, H x1, H x2) {
+        relpose_5pt(points_argument<5>(x1, "x1"), points_argument<5>(x2, "x2"), p);
       },
-      "x1"_a, "x2"_a,
-      solver_doc(SolverId::k5pt, "(x1, x2)",
-                 "x1, x2: 5 x 2 point matches. Nister's five-point essential matrix, decomposed.\n")
-          .c_str());
+      "x1"_a, "x2"_a);
 
-  m.def(
-      "relpose_homography_4pt",
-      [](py::handle x1, py::handle x2) {
-        RelativePoses poses;
-        relpose_homography_4pt(points_argument<4>(x1, "x1"), points_argument<4>(x2, "x2"), &poses);
-        return poses_to_list(poses);
+  def_solver(
+      m, SolverId::kHomography4pt, "(x1, x2)",
+      "x1, x2: 4 x 2 matches of coplanar points. Homography by DLT, decomposed.\n",
+      +[](RelativePoses* p, H x1, H x2) {
+        relpose_homography_4pt(points_argument<4>(x1, "x1"), points_argument<4>(x2, "x2"), p);
       },
-      "x1"_a, "x2"_a,
-      solver_doc(SolverId::kHomography4pt, "(x1, x2)",
-                 "x1, x2: 4 x 2 matches of coplanar points. Homography by DLT, decomposed.\n")
-          .c_str());
+      "x1"_a, "x2"_a);
 
-  m.def(
-      "relpose_homography_3pt_1line",
-      [](py::handle x1, py::handle x2, py::handle s1, py::handle s2) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::kHomography3pt1l, "(x1, x2, s1, s2)",
+      "x1, x2: 3 x 2 point matches; s1, s2: one segment match (1 x 4 or 4,), all on one plane.\n"
+      "Lines map as l1 ~ H^T l2; the endpoints need not correspond.\n",
+      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
         relpose_homography_3pt_1line(points_argument<3>(x1, "x1"), points_argument<3>(x2, "x2"),
                                      segments_argument<1>(s1, "s1")[0],
-                                     segments_argument<1>(s2, "s2")[0], &poses);
-        return poses_to_list(poses);
+                                     segments_argument<1>(s2, "s2")[0], p);
       },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a,
-      solver_doc(SolverId::kHomography3pt1l, "(x1, x2, s1, s2)",
-                 "x1, x2: 3 x 2 point matches; s1, s2: one segment match (1 x 4 or 4,), all on "
-                 "one plane.\nLines map as l1 ~ H^T l2; the endpoints need not correspond.\n")
-          .c_str());
+      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
 
-  m.def(
-      "relpose_homography_2pt_2line",
-      [](py::handle x1, py::handle x2, py::handle s1, py::handle s2) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::kHomography2pt2l, "(x1, x2, s1, s2)",
+      "x1, x2: 2 x 2 point matches; s1, s2: 2 x 4 segment matches, coplanar.\n"
+      "Degenerate for every input (a one-parameter family of homographies fits; README): it "
+      "always\nreturns an empty list, and is listed for completeness.\n",
+      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
         relpose_homography_2pt_2line(points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"),
                                      segments_argument<2>(s1, "s1"), segments_argument<2>(s2, "s2"),
-                                     &poses);
-        return poses_to_list(poses);
+                                     p);
       },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a,
-      solver_doc(SolverId::kHomography2pt2l, "(x1, x2, s1, s2)",
-                 "x1, x2: 2 x 2 point matches; s1, s2: 2 x 4 segment matches, coplanar.\n"
-                 "Degenerate for every input (a one-parameter family of homographies fits; "
-                 "README): it always\nreturns an empty list, and is listed for completeness.\n")
-          .c_str());
+      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
 
-  m.def(
-      "relpose_homography_1pt_3line",
-      [](py::handle x1, py::handle x2, py::handle s1, py::handle s2) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::kHomography1pt3l, "(x1, x2, s1, s2)",
+      "x1, x2: one point match (1 x 2 or 2,); s1, s2: 3 x 4 segment matches, all on one plane.\n",
+      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
         relpose_homography_1pt_3line(
             points_argument<1>(x1, "x1")[0], points_argument<1>(x2, "x2")[0],
-            segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), &poses);
-        return poses_to_list(poses);
+            segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), p);
       },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a,
-      solver_doc(SolverId::kHomography1pt3l, "(x1, x2, s1, s2)",
-                 "x1, x2: one point match (1 x 2 or 2,); s1, s2: 3 x 4 segment matches, all on "
-                 "one plane.\n")
-          .c_str());
+      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
 
-  m.def(
-      "relpose_homography_4line",
-      [](py::handle s1, py::handle s2) {
-        RelativePoses poses;
-        relpose_homography_4line(segments_argument<4>(s1, "s1"), segments_argument<4>(s2, "s2"),
-                                 &poses);
-        return poses_to_list(poses);
+  def_solver(
+      m, SolverId::kHomography4l, "(s1, s2)", "s1, s2: 4 x 4 matches of coplanar segments.\n",
+      +[](RelativePoses* p, H s1, H s2) {
+        relpose_homography_4line(segments_argument<4>(s1, "s1"), segments_argument<4>(s2, "s2"), p);
       },
-      "s1"_a, "s2"_a,
-      solver_doc(SolverId::kHomography4l, "(s1, s2)",
-                 "s1, s2: 4 x 4 matches of coplanar segments.\n")
-          .c_str());
+      "s1"_a, "s2"_a);
 
-  m.def(
-      "relpose_2pt_3line",
-      [](py::handle x1, py::handle x2, py::handle s1, py::handle s2) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::k2pt3line, "(x1, x2, s1, s2)",
+      "x1, x2: 2 x 2 point matches; s1, s2: 3 x 4 matches of coplanar segments, whose three\n"
+      "junctions complete five points for the five-point solver.\n",
+      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
         relpose_2pt_3line(points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"),
-                          segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), &poses);
-        return poses_to_list(poses);
+                          segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), p);
       },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a,
-      solver_doc(SolverId::k2pt3line, "(x1, x2, s1, s2)",
-                 "x1, x2: 2 x 2 point matches; s1, s2: 3 x 4 matches of coplanar segments, whose "
-                 "three\njunctions complete five points for the five-point solver.\n")
-          .c_str());
+      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
 
-  m.def(
-      "relpose_1vp_3pt",
-      [](py::handle v1, py::handle v2, py::handle x1, py::handle x2, py::handle known) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::k1vp3pt, "(v1, v2, x1, x2, vp_sign_known=False)",
+      std::string("v1, v2: one VP match; x1, x2: 3 x 2 point matches. Upright three-point after "
+                  "rotating the VP\nonto the y-axis.\n") +
+          kVpSign,
+      +[](RelativePoses* p, H v1, H v2, H x1, H x2, H known) {
         relpose_1vp_3pt(vp_argument(v1, "v1"), vp_argument(v2, "v2"), points_argument<3>(x1, "x1"),
-                        points_argument<3>(x2, "x2"), &poses,
-                        bool_argument(known, "vp_sign_known"));
-        return poses_to_list(poses);
+                        points_argument<3>(x2, "x2"), p, bool_argument(known, "vp_sign_known"));
       },
-      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false,
-      solver_doc(SolverId::k1vp3pt, "(v1, v2, x1, x2, vp_sign_known=False)",
-                 std::string("v1, v2: one VP match; x1, x2: 3 x 2 point matches. Upright "
-                             "three-point after rotating the VP\nonto the y-axis.\n") +
-                     kVpSign)
-          .c_str());
+      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
 
-  m.def(
-      "relpose_1vp_3line",
-      [](py::handle v1, py::handle v2, py::handle s1, py::handle s2, py::handle known) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::k1vp3line, "(v1, v2, s1, s2, vp_sign_known=False)",
+      std::string("v1, v2: one VP match; s1, s2: 3 x 4 matches of coplanar segments (their "
+                  "junctions are the\npoints of 3-0-1).\n") +
+          kVpSign,
+      +[](RelativePoses* p, H v1, H v2, H s1, H s2, H known) {
         relpose_1vp_3line(vp_argument(v1, "v1"), vp_argument(v2, "v2"),
-                          segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), &poses,
+                          segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), p,
                           bool_argument(known, "vp_sign_known"));
-        return poses_to_list(poses);
       },
-      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "vp_sign_known"_a = false,
-      solver_doc(SolverId::k1vp3line, "(v1, v2, s1, s2, vp_sign_known=False)",
-                 std::string("v1, v2: one VP match; s1, s2: 3 x 4 matches of coplanar segments "
-                             "(their junctions are the\npoints of 3-0-1).\n") +
-                     kVpSign)
-          .c_str());
+      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "vp_sign_known"_a = false);
 
-  m.def(
-      "relpose_2vp_2pt",
-      [](py::handle v1, py::handle v2, py::handle x1, py::handle x2, py::handle known) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::k2vp2pt, "(v1, v2, x1, x2, vp_signs_known=False)",
+      "v1, v2: two VP matches (2 x 3, row k of v1 matches row k of v2); x1, x2: 2 x 2 point "
+      "matches.\nWith vp_signs_known, v2 = +R v1 for both; otherwise every sign is tried.\n",
+      +[](RelativePoses* p, H v1, H v2, H x1, H x2, H known) {
         relpose_2vp_2pt(two_vps_argument(v1, "v1"), two_vps_argument(v2, "v2"),
-                        points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"), &poses,
+                        points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"), p,
                         bool_argument(known, "vp_signs_known"));
-        return poses_to_list(poses);
       },
-      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_signs_known"_a = false,
-      solver_doc(SolverId::k2vp2pt, "(v1, v2, x1, x2, vp_signs_known=False)",
-                 "v1, v2: two VP matches (2 x 3, row k of v1 matches row k of v2); x1, x2: 2 x 2 "
-                 "point matches.\nWith vp_signs_known, v2 = +R v1 for both; otherwise every sign "
-                 "is tried.\n")
-          .c_str());
+      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_signs_known"_a = false);
 
-  m.def(
-      "relpose_1vp_orthline_2pt",
-      [](py::handle v1, py::handle v2, py::handle s1, py::handle s2, py::handle x1, py::handle x2,
-         py::handle known) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::k1vpOrthline2pt, "(v1, v2, s1, s2, x1, x2, vp_sign_known=False)",
+      std::string("v1, v2: one VP match; s1, s2: one segment match (1 x 4 or 4,) whose 3D line "
+                  "is orthogonal\nto the VP; x1, x2: 2 x 2 point matches.\n") +
+          kVpSign,
+      +[](RelativePoses* p, H v1, H v2, H s1, H s2, H x1, H x2, H known) {
         relpose_1vp_orthline_2pt(
             vp_argument(v1, "v1"), vp_argument(v2, "v2"), segments_argument<1>(s1, "s1")[0],
             segments_argument<1>(s2, "s2")[0], points_argument<2>(x1, "x1"),
-            points_argument<2>(x2, "x2"), &poses, bool_argument(known, "vp_sign_known"));
-        return poses_to_list(poses);
+            points_argument<2>(x2, "x2"), p, bool_argument(known, "vp_sign_known"));
       },
-      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false,
-      solver_doc(SolverId::k1vpOrthline2pt, "(v1, v2, s1, s2, x1, x2, vp_sign_known=False)",
-                 std::string("v1, v2: one VP match; s1, s2: one segment match (1 x 4 or 4,) "
-                             "whose 3D line is orthogonal\nto the VP; x1, x2: 2 x 2 point "
-                             "matches.\n") +
-                     kVpSign)
-          .c_str());
+      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
 
-  m.def(
-      "relpose_1vp_2line_1pt",
-      [](py::handle v1, py::handle v2, py::handle s1, py::handle s2, py::handle x1, py::handle x2,
-         py::handle known) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::k1vp2line1pt, "(v1, v2, s1, s2, x1, x2, vp_sign_known=False)",
+      std::string("v1, v2: one VP match; s1, s2: 2 x 4 matches of intersecting segments, the "
+                  "first orthogonal\nto the VP; x1, x2: one point match (1 x 2 or 2,).\n") +
+          kVpSign,
+      +[](RelativePoses* p, H v1, H v2, H s1, H s2, H x1, H x2, H known) {
         relpose_1vp_2line_1pt(vp_argument(v1, "v1"), vp_argument(v2, "v2"),
                               segments_argument<2>(s1, "s1"), segments_argument<2>(s2, "s2"),
-                              points_argument<1>(x1, "x1")[0], points_argument<1>(x2, "x2")[0],
-                              &poses, bool_argument(known, "vp_sign_known"));
-        return poses_to_list(poses);
+                              points_argument<1>(x1, "x1")[0], points_argument<1>(x2, "x2")[0], p,
+                              bool_argument(known, "vp_sign_known"));
       },
-      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false,
-      solver_doc(SolverId::k1vp2line1pt, "(v1, v2, s1, s2, x1, x2, vp_sign_known=False)",
-                 std::string("v1, v2: one VP match; s1, s2: 2 x 4 matches of intersecting "
-                             "segments, the first orthogonal\nto the VP; x1, x2: one point match "
-                             "(1 x 2 or 2,).\n") +
-                     kVpSign)
-          .c_str());
+      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
 
-  m.def(
-      "relpose_1vp_2pt_orth",
-      [](py::handle v1, py::handle v2, py::handle x1, py::handle x2, py::handle known) {
-        RelativePoses poses;
+  def_solver(
+      m, SolverId::k1vp2ptOrth, "(v1, v2, x1, x2, vp_sign_known=False)",
+      std::string("v1, v2: one VP match; x1, x2: 2 x 2 point matches whose 3D points span a line "
+                  "orthogonal\nto the VP.\n") +
+          kVpSign,
+      +[](RelativePoses* p, H v1, H v2, H x1, H x2, H known) {
         relpose_1vp_2pt_orth(vp_argument(v1, "v1"), vp_argument(v2, "v2"),
-                             points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"), &poses,
+                             points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"), p,
                              bool_argument(known, "vp_sign_known"));
-        return poses_to_list(poses);
       },
-      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false,
-      solver_doc(SolverId::k1vp2ptOrth, "(v1, v2, x1, x2, vp_sign_known=False)",
-                 std::string("v1, v2: one VP match; x1, x2: 2 x 2 point matches whose 3D "
-                             "points span a line orthogonal\nto the VP.\n") +
-                     kVpSign)
-          .c_str());
+      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
 
   m.def(
       "solve_minimal",
@@ -313,21 +270,13 @@ void bind_solvers(py::module_& m) {
       "solvers",
       [] {
         py::list out;
-        for (const SolverInfo& info : solver_table()) {
-          py::dict d;
-          d["code"] = info.code;
-          d["ascii_code"] = ascii_code(info);
-          d["function"] = info.function;
-          d["num_points"] = info.num_points;
-          d["num_lines"] = info.num_lines;
-          d["num_vps"] = info.num_vps;
-          d["coplanar"] = info.coplanar;
-          d["lines_coplanar"] = info.lines_coplanar;
-          d["orthogonal"] = info.orthogonal;
-          d["well_posed"] = info.well_posed;
-          d["inputs"] = info.inputs;
-          out.append(d);
-        }
+        for (const SolverInfo& info : solver_table())
+          out.append(py::dict(
+              "code"_a = info.code, "ascii_code"_a = ascii_code(info), "function"_a = info.function,
+              "num_points"_a = info.num_points, "num_lines"_a = info.num_lines,
+              "num_vps"_a = info.num_vps, "coplanar"_a = info.coplanar,
+              "lines_coplanar"_a = info.lines_coplanar, "orthogonal"_a = info.orthogonal,
+              "well_posed"_a = info.well_posed, "inputs"_a = info.inputs));
         return out;
       },
       "solvers()\n--\n\n"
