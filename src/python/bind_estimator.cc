@@ -211,16 +211,21 @@ void bind_estimator(py::module_& m) {
           "endpoint_inliers",
           [](const Estimate& e) { return to_bool_array(e.est().endpoint_inliers); },
           "Per segment endpoint match (see endpoints).")
-      .def_property_readonly("num_point_inliers",
-                             [](const Estimate& e) { return e.est().num_point_inliers; })
-      .def_property_readonly("num_line_inliers",
-                             [](const Estimate& e) { return e.est().num_line_inliers; })
-      .def_property_readonly("num_vp_inliers",
-                             [](const Estimate& e) { return e.est().num_vp_inliers; })
-      .def_property_readonly("num_junction_inliers",
-                             [](const Estimate& e) { return e.est().num_junction_inliers; })
-      .def_property_readonly("num_endpoint_inliers",
-                             [](const Estimate& e) { return e.est().num_endpoint_inliers; })
+      .def_property_readonly(
+          "num_point_inliers", [](const Estimate& e) { return e.est().num_point_inliers; },
+          "Number of point inliers.")
+      .def_property_readonly(
+          "num_line_inliers", [](const Estimate& e) { return e.est().num_line_inliers; },
+          "Number of line inliers.")
+      .def_property_readonly(
+          "num_vp_inliers", [](const Estimate& e) { return e.est().num_vp_inliers; },
+          "Number of VP inliers.")
+      .def_property_readonly(
+          "num_junction_inliers", [](const Estimate& e) { return e.est().num_junction_inliers; },
+          "Number of junction inliers.")
+      .def_property_readonly(
+          "num_endpoint_inliers", [](const Estimate& e) { return e.est().num_endpoint_inliers; },
+          "Number of endpoint inliers.")
       .def_property_readonly(
           "junctions", [](const Estimate& e) { return derived_points(e.est().junctions); },
           "J x 4 junction matches in pixels (x1, y1, x2, y2), from segment pairs "
@@ -277,9 +282,11 @@ void bind_estimator(py::module_& m) {
             return py::str(solver_info(e.est().best_solver).function);
           },
           "Function name of the solver behind the best model, or None.")
-      .def_property_readonly("iterations", [](const Estimate& e) { return e.est().iterations; })
-      .def_property_readonly("local_optimizations",
-                             [](const Estimate& e) { return e.est().local_optimizations; })
+      .def_property_readonly(
+          "iterations", [](const Estimate& e) { return e.est().iterations; }, "RANSAC iterations.")
+      .def_property_readonly(
+          "local_optimizations", [](const Estimate& e) { return e.est().local_optimizations; },
+          "Local optimisations of new best models.")
       .def_property_readonly(
           "refined", [](const Estimate& e) { return e.est().refined; },
           "True when the final Ceres refinement was kept.")
@@ -301,7 +308,7 @@ void bind_estimator(py::module_& m) {
           },
           "Milliseconds: VP detection, derived data (junctions), RANSAC, final refinement, the "
           "whole\nestimator, and VP detection plus estimator.")
-      .def("__repr__", &repr);
+      .def("__repr__", &repr, "Status, inliers, best solver, iterations and time in one line.");
 
   m.def(
       "estimate_relative_pose", &estimate, "camera1"_a, "camera2"_a, "points1"_a, "points2"_a,
