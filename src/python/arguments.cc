@@ -33,9 +33,15 @@ bool is_numpy_scalar_of(py::handle value, const char* kind) {
   return py::isinstance(value, numpy().attr(kind));
 }
 
-// Lists and tuples become arrays; NumPy arrays pass unchanged; anything else is refused.
+// Lists and tuples become arrays; NumPy arrays pass unchanged; anything else is refused. A
+// masked array is refused too: its masked values would be read as if they were data.
 py::array as_array(py::handle value, const std::string& name, const std::string& expected) {
-  if (py::isinstance<py::array>(value)) return py::reinterpret_borrow<py::array>(value);
+  if (py::isinstance<py::array>(value)) {
+    if (!py::type::handle_of(value).is(numpy().attr("ndarray")) &&
+        py::isinstance(value, numpy().attr("ma").attr("MaskedArray")))
+      throw_value_error(name, "a masked array; pass the valid rows as a plain array");
+    return py::reinterpret_borrow<py::array>(value);
+  }
   if (!py::isinstance<py::list>(value) && !py::isinstance<py::tuple>(value))
     throw_value_error(name, "expected " + expected + ", got " + type_name(value));
   try {
@@ -135,6 +141,10 @@ long long integer_argument(py::handle value, const std::string& name) {
     throw_value_error(name, "expected an integer, got " + std::string(py::repr(value)));
   int overflow = 0;
   const py::object as_int = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!as_int) {
+    PyErr_Clear();
+    throw_value_error(name, "expected an integer, got " + std::string(py::repr(value)));
+  }
   const long long v = PyLong_AsLongLongAndOverflow(as_int.ptr(), &overflow);
   if (overflow != 0)
     throw_value_error(name, "integer out of range: " + std::string(py::repr(value)));

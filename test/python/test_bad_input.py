@@ -44,6 +44,7 @@ BAD_POINTS = [
     ("object", X5.astype(object), "float64"),
     ("strings", [["a", "b"]] * 5, "numbers"),
     ("ragged_list", [[0.0, 1.0]] * 4 + [[0.0]], "array"),
+    ("masked", np.ma.masked_array(X5, mask=X5 > 0), "masked"),
     ("none", None, "expected"),
     ("scalar", 3.0, "expected"),
     ("dict", {"x": 1}, "expected"),
