@@ -133,8 +133,8 @@ double line_error_px(const RenderedView& view1, const CameraPose& pose1, const C
     if (x < 0 || y < 0 || x >= view1.depth.cols || y >= view1.depth.rows) return -1.0;
     const float z = view1.depth.at<float>(y, x);
     if (!(z > 0.0f)) return -1.0;
-    const Eigen::Vector3d X =
-        pose1.to_world(Eigen::Vector3d((p.x() - cam.cx) / cam.fx, (p.y() - cam.cy) / cam.fy, 1.0) * z);
+    const Eigen::Vector3d ray((p.x() - cam.cx) / cam.fx, (p.y() - cam.cy) / cam.fy, 1.0);
+    const Eigen::Vector3d X = pose1.to_world(ray * z);
     const Eigen::Vector3d Xc = pose2.to_camera(X);
     if (Xc.z() <= 0.0) return -1.0;
     const Eigen::Vector2d q(cam.fx * Xc.x() / Xc.z() + cam.cx, cam.fy * Xc.y() / Xc.z() + cam.cy);

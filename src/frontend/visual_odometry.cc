@@ -81,6 +81,13 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
 
 VisualOdometry::~VisualOdometry() = default;
 
+std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
+  std::map<int64_t, Eigen::Vector2d> points;
+  for (size_t i = 0; i < klt_.points().size(); ++i)
+    points[klt_.ids()[i]] = Eigen::Vector2d(klt_.points()[i].x, klt_.points()[i].y);
+  return points;
+}
+
 void VisualOdometry::reset() {
   klt_.reset();
   vp_tracker_.reset();
@@ -134,7 +141,9 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   // Features of this frame: the segments on the second thread while this one does the points.
   std::map<int64_t, Eigen::Vector2d> points;
   ImageFeatures features;
-  WorkerJob lines_job;
+  WorkerJob lines_job, redetect_job;
+  const bool tracking =
+      !input.external.has_points && options_.point_source == PointFeatureSource::kTracking;
   if (options_.use_lines && !input.external.has_lines) {
     lines_job = worker_->submit([&] {
       const auto lines_start = std::chrono::steady_clock::now();
@@ -147,10 +156,16 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     for (size_t i = 0; i < input.external.points.size() && i < input.external.point_ids.size(); ++i)
       if (all_finite(input.external.points[i]))
         points[input.external.point_ids[i]] = input.external.points[i];
-  } else if (options_.point_source == PointFeatureSource::kTracking) {
-    klt_.track(gray);
-    for (size_t i = 0; i < klt_.points().size(); ++i)
-      points[klt_.ids()[i]] = Eigen::Vector2d(klt_.points()[i].x, klt_.points()[i].y);
+  } else if (tracking) {
+    klt_.track_existing(gray);
+    points = klt_points();
+    // The re-detection serves only the next frame: on the second thread after the segments,
+    // while this one matches and estimates. `points` holds the tracked features until then.
+    redetect_job = worker_->submit([&] {
+      const auto redetect_start = std::chrono::steady_clock::now();
+      klt_.detect_new();
+      times.redetect_ms = ms_since(redetect_start);
+    });
   } else {
     features.points = detect_point_features(gray, options_.features.points);
     for (size_t i = 0; i < features.points.keypoints.size(); ++i)
@@ -164,20 +179,22 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   std::map<int64_t, Eigen::Vector3d> points3d;
   std::atomic<bool> skip_stereo{false};
   WorkerJob stereo_job;
-  if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
+  if (!input.right_image.empty() && input.baseline_m > 0.0 && (tracking || !points.empty())) {
     stereo_job = worker_->submit([&] {
       if (skip_stereo) return;
       const auto stereo_start = std::chrono::steady_clock::now();
-      points3d = stereo_points_by_id(gray, input.right_image, points, input.camera.pinhole,
-                                     input.baseline_m, options_.stereo);
+      points3d = stereo_points_by_id(gray, input.right_image, tracking ? klt_points() : points,
+                                     input.camera.pinhole, input.baseline_m, options_.stereo);
       times.stereo_ms = ms_since(stereo_start);
     });
   }
   lines_job.get();
 
   if (!keyframe_.valid) {
+    redetect_job.get();
     stereo_job.get();
-    make_keyframe(input, points, std::move(features), std::move(points3d));
+    make_keyframe(input, tracking ? klt_points() : points, std::move(features),
+                  std::move(points3d));
     r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
     r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
     r.reference_stamp = input.stamp;
@@ -223,8 +240,10 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
 
   if (r.num_point_matches < options_.min_point_matches &&
       r.num_line_matches < options_.min_line_matches) {
+    redetect_job.get();
     stereo_job.get();
-    make_keyframe(input, points, std::move(features), std::move(points3d));
+    make_keyframe(input, tracking ? klt_points() : points, std::move(features),
+                  std::move(points3d));
     r.status = VoStatus::kTooFewFeatures;
     r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
@@ -240,6 +259,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       r.message = "median motion " + std::to_string(motion[motion.size() / 2]) + " px";
       skip_stereo = true;
       stereo_job.wait();
+      redetect_job.get();
       r.total_ms = ms_since(start);
       return r;
     }
@@ -297,6 +317,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     r.message = std::string("estimator: ") + hybrid_vo::to_string(est.status);
     skip_stereo = true;
     stereo_job.wait();
+    redetect_job.get();
     r.total_ms = ms_since(start);
     return r;
   }
@@ -337,8 +358,10 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     }
     vp_tracker_.update(R_wc_, d2, weights);
   }
+  redetect_job.get();
   stereo_job.get();
-  make_keyframe(input, points, std::move(features), std::move(points3d));
+  make_keyframe(input, tracking ? klt_points() : points, std::move(features),
+                std::move(points3d));
   r.status = VoStatus::kOk;
   r.message = "ok";
   r.total_ms = ms_since(start);

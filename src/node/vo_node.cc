@@ -405,6 +405,7 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
   rel.estimator_ms = result.estimator_ms;
   rel.total_ms = result.total_ms;
   rel.points_ms = result.stages.points_ms;
+  rel.redetect_ms = result.stages.redetect_ms;
   rel.lines_ms = result.stages.lines_ms;
   rel.line_matching_ms = result.stages.line_matching_ms;
   rel.vps_ms = result.stages.vps_ms;
@@ -632,6 +633,7 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("estimator (ms)", r.estimator_ms);
   status.add("total (ms)", r.total_ms);
   status.add("points (ms)", r.stages.points_ms);
+  status.add("re-detection (ms)", r.stages.redetect_ms);
   status.add("lines (ms)", r.stages.lines_ms);
   status.add("line matching (ms)", r.stages.line_matching_ms);
   status.add("VPs (ms)", r.stages.vps_ms);

@@ -29,7 +29,8 @@ void usage(const char* program) {
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
-               "  tracking; --no-predict: KLT without motion prediction. Default preset hybrid+junc.\n";
+               "  tracking; --no-predict: KLT without motion prediction. Default preset\n"
+               "  hybrid+junc.\n";
 }
 
 double cpu_ms() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
@@ -89,8 +90,8 @@ int run(int argc, char** argv) {
   input.camera.pinhole.height = images[0].rows;
 
   VisualOdometry vo(o);
-  std::vector<double> total, frontend, estimator, points, lines, matching, vps, ransac, cpu,
-      line_matches, line_inliers, tracked, fallback;
+  std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
+      cpu, line_matches, line_inliers, tracked, fallback;
   int ok = 0;
   double lines_sum = 0.0, inliers_sum = 0.0, searched_sum[2] = {0, 0}, fallback_sum[2] = {0, 0};
   for (int i = 0; i < frames; ++i) {
@@ -104,6 +105,7 @@ int run(int argc, char** argv) {
     frontend.push_back(r.frontend_ms);
     estimator.push_back(r.estimator_ms);
     points.push_back(r.stages.points_ms);
+    redetect.push_back(r.stages.redetect_ms);
     lines.push_back(r.stages.lines_ms);
     matching.push_back(r.stages.line_matching_ms);
     vps.push_back(r.stages.vps_ms);
@@ -127,10 +129,11 @@ int run(int argc, char** argv) {
   std::printf("frames %d, estimated %d (%s, %s, %s)\n", frames, ok,
               o.concurrent ? "concurrent" : "sequential", o.track_lines ? "line tracking" : "LBD",
               o.klt.predict_motion ? "KLT prediction" : "KLT plain");
-  std::printf("median ms: total %.1f, front end %.1f, estimator %.1f; points %.1f, lines %.1f, "
+  std::printf("median ms: total %.1f, front end %.1f, estimator %.1f; points %.1f, "
+              "re-detection %.1f, lines %.1f, "
               "line matching %.1f, VPs %.1f, RANSAC %.1f; CPU per frame %.1f\n",
-              median(total), median(frontend), median(estimator), median(points), median(lines),
-              median(matching), median(vps), median(ransac), median(cpu));
+              median(total), median(frontend), median(estimator), median(points), median(redetect),
+              median(lines), median(matching), median(vps), median(ransac), median(cpu));
   std::printf("median per estimated frame: line matches %.0f, line inliers %.0f, tracked %.0f, "
               "by LBD fallback %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
               median(line_matches), median(line_inliers), median(tracked), median(fallback),

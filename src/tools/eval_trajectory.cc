@@ -255,14 +255,15 @@ int main(int argc, char** argv) {
   // what bounds the frame rate through the node. Then where it goes, stage by stage (the stages
   // overlap: the segments and the stereo matching run on a second thread), and the matches.
   if (!run.motions.empty()) {
-    std::vector<double> frontend, estimator, total, points, lines, line_matching, vps, ransac,
-        stereo, point_matches, point_inliers, line_matches, line_inliers;
+    std::vector<double> frontend, estimator, total, points, redetect, lines, line_matching, vps,
+        ransac, stereo, point_matches, point_inliers, line_matches, line_inliers;
     double lines_sum = 0.0, line_inliers_sum = 0.0;
     for (const hybrid_vo::MotionEstimate& m : run.motions) {
       frontend.push_back(m.frontend_ms);
       estimator.push_back(m.estimator_ms);
       total.push_back(m.total_ms);
       points.push_back(m.points_ms);
+      redetect.push_back(m.redetect_ms);
       lines.push_back(m.lines_ms);
       line_matching.push_back(m.line_matching_ms);
       vps.push_back(m.vps_ms);
@@ -282,10 +283,10 @@ int main(int argc, char** argv) {
                 "frames/s\n",
                 median(frontend), median(estimator), median(total),
                 1000.0 / std::max(1e-3, median(total)));
-    std::printf("# per stage (median ms): points %.1f, lines %.1f, line matching %.1f, VPs %.1f, "
-                "RANSAC %.1f, stereo %.1f\n",
-                median(points), median(lines), median(line_matching), median(vps), median(ransac),
-                median(stereo));
+    std::printf("# per stage (median ms): points %.1f, re-detection %.1f, lines %.1f, line "
+                "matching %.1f, VPs %.1f, RANSAC %.1f, stereo %.1f\n",
+                median(points), median(redetect), median(lines), median(line_matching), median(vps),
+                median(ransac), median(stereo));
     if (!point_matches.empty())
       std::printf("# matches per estimated frame (median): points %.0f (%.0f inliers), lines %.0f "
                   "(%.0f inliers); line inlier ratio %.3f (all frames pooled)\n",

@@ -8,7 +8,8 @@ namespace hybrid_vo {
 // The segments and the stereo matching run on a second thread beside the points and the
 // estimator, so the stages overlap and need not add up to the frame's total.
 struct StageTimings {
-  double points_ms = 0.0;         // KLT tracking and re-detection (or detection + description)
+  double points_ms = 0.0;         // KLT tracking (or detection + description)
+  double redetect_ms = 0.0;       // KLT re-detection for the next frame (second thread)
   double lines_ms = 0.0;          // segment detection and LBD description (second thread)
   double line_matching_ms = 0.0;  // segment tracking or matching against the keyframe
   double vps_ms = 0.0;            // joint VP detection and the VP tracker

@@ -135,6 +135,9 @@ class VisualOdometry {
                      const std::map<int64_t, Eigen::Vector2d>& points, ImageFeatures features,
                      std::map<int64_t, Eigen::Vector3d> points3d);
 
+  // Every feature the KLT tracker holds, by id.
+  std::map<int64_t, Eigen::Vector2d> klt_points() const;
+
   VisualOdometryOptions options_;
   std::unique_ptr<WorkerThread> worker_;
   KltTracker klt_;
