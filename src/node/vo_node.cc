@@ -143,6 +143,7 @@ void VoNode::load_parameters() {
   }
   o.use_vp_tracker = pnh_.param("vp_tracker", true);
   o.track_lines = pnh_.param("track_lines", true);
+  o.klt.predict_motion = pnh_.param("klt_predict_motion", true);
   o.concurrent = pnh_.param("concurrent_frontend", true);
 }
 
