@@ -108,11 +108,6 @@ struct Pair {
 // A scale estimator: the scale, or NaN, and optionally its sigma.
 using Candidate = std::function<double(const Pair&, double* sigma)>;
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
-}
 
 }  // namespace
 
@@ -287,7 +282,7 @@ int main(int argc, char** argv) {
     std::printf("%-12s ratio median %.4f (p10 %.4f, p90 %.4f) over %zu pairs; drift %.2f %% "
                 "%.3f deg/100 m; ATE %.4f m",
                 candidates[k].name.c_str(), hybrid_vo::tools::median(ratios[k]),
-                percentile(ratios[k], 0.1), percentile(ratios[k], 0.9), ratios[k].size(),
+                hybrid_vo::tools::percentile(ratios[k], 0.1), hybrid_vo::tools::percentile(ratios[k], 0.9), ratios[k].size(),
                 te.drift_trans_percent, te.drift_rot_deg_per_100m, te.ate);
     if (!z[k].empty())
       std::printf("; |error| <= sigma in %.0f %% of pairs", 100.0 * within / z[k].size());
