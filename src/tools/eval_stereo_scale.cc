@@ -28,6 +28,7 @@
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/node/conversions.h"
 #include "statistics.h"
+#include "tool_args.h"
 #include "trajectory.h"
 
 namespace {
@@ -116,13 +117,7 @@ int main(int argc, char** argv) {
   int max_features = 1000, max_frames = 1 << 30;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) {
-        std::cerr << "error: " << a << " needs a value\n";
-        std::exit(2);
-      }
-      return argv[++i];
-    };
+    auto next = [&] { return hybrid_vo::tools::option_value(argc, argv, &i); };
     if (a == "--bag") bag = next();
     else if (a == "--preset") preset = next();
     else if (a == "--max-features") max_features = std::stoi(next());
