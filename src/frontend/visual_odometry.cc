@@ -19,25 +19,6 @@ bool uses_vps(const RelativePoseEstimatorOptions& options) {
   return false;
 }
 
-// Metric 3D points (left camera) of a rectified stereo pair's features, by id.
-std::map<int64_t, Eigen::Vector3d> stereo_points_by_id(
-    const cv::Mat& left, const cv::Mat& right, const std::map<int64_t, Eigen::Vector2d>& points,
-    const PinholeCamera& camera, double baseline_m, const StereoOptions& options) {
-  std::map<int64_t, Eigen::Vector3d> points3d;
-  std::vector<int64_t> ids;
-  std::vector<Eigen::Vector2d> pixels;
-  for (const auto& [id, p] : points) {
-    ids.push_back(id);
-    pixels.push_back(p);
-  }
-  std::vector<char> valid;
-  const std::vector<Eigen::Vector3d> X =
-      stereo_points(left, to_gray8(right), pixels, camera, baseline_m, &valid, options);
-  for (size_t i = 0; i < ids.size(); ++i)
-    if (valid[i]) points3d[ids[i]] = X[i];
-  return points3d;
-}
-
 }  // namespace
 
 VisualOdometryOptions::VisualOdometryOptions() {
@@ -69,7 +50,8 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
     : options_(options),
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
       klt_(options.klt),
-      vp_tracker_(options.vp_tracker) {
+      vp_tracker_(options.vp_tracker),
+      offset_filter_(options.stereo_offset) {
   if (options_.use_vp_tracker) {
     // The tracker feeds d1 from directions averaged over many frames: trust them as given (they
     // pin the rotation to the tracked Manhattan frame, which stops rotational drift) rather than
@@ -98,14 +80,37 @@ void VisualOdometry::reset() {
   tracker_seeded_ = false;
 }
 
+std::map<int64_t, Eigen::Vector3d> VisualOdometry::stereo_of(
+    const VisualOdometryInput& input, const cv::Mat& gray,
+    const std::map<int64_t, Eigen::Vector2d>& points) const {
+  // Stereo: metric 3D points of the frame's features, for the scale of this and the next motion.
+  std::map<int64_t, Eigen::Vector3d> points3d;
+  if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
+    std::vector<int64_t> ids;
+    std::vector<Eigen::Vector2d> pixels;
+    for (const auto& [id, p] : points) {
+      ids.push_back(id);
+      pixels.push_back(p);
+    }
+    std::vector<char> valid;
+    const std::vector<Eigen::Vector3d> X = stereo_points(
+        gray, to_gray8(input.right_image), pixels, input.camera.pinhole, input.baseline_m, &valid,
+        options_.stereo);
+    for (size_t i = 0; i < ids.size(); ++i)
+      if (valid[i]) points3d[ids[i]] = X[i];
+  }
+  return points3d;
+}
+
 void VisualOdometry::make_keyframe(const VisualOdometryInput& input,
                                    const std::map<int64_t, Eigen::Vector2d>& points,
-                                   ImageFeatures features,
-                                   std::map<int64_t, Eigen::Vector3d> points3d) {
+                                   std::map<int64_t, Eigen::Vector3d> points3d,
+                                   ImageFeatures features) {
   keyframe_ = Keyframe();
   keyframe_.valid = true;
   keyframe_.stamp = input.stamp;
   keyframe_.points = points;
+  keyframe_.points3d = std::move(points3d);
   keyframe_.features = std::move(features);
   keyframe_.camera = input.camera;
   keyframe_.R_wc = R_wc_;
@@ -115,8 +120,6 @@ void VisualOdometry::make_keyframe(const VisualOdometryInput& input,
       keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];
   keyframe_.points_undistorted = input.external.has_points && input.external.points_undistorted;
   keyframe_.lines_undistorted = input.external.has_lines && input.external.lines_undistorted;
-  // Stereo: metric 3D points of the keyframe's features, for the scale of the next motion.
-  keyframe_.points3d = std::move(points3d);
 }
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
@@ -173,18 +176,18 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
                                                         features.points.keypoints[i].pt.y);
   }
   times.points_ms = ms_since(points_start);
-  // Stereo matching of this frame's points, for the scale of the next motion: on the second
-  // thread while this one matches and estimates. Skipped when the frame turns out not to be kept
-  // before it starts.
+  // Stereo matching of this frame's points (after the re-detection: the next keyframe needs them
+  // all), for the scale of this and the next motion: on the second thread while this one matches
+  // and estimates. Skipped when the frame turns out not to be kept before it starts.
   std::map<int64_t, Eigen::Vector3d> points3d;
   std::atomic<bool> skip_stereo{false};
   WorkerJob stereo_job;
-  if (!input.right_image.empty() && input.baseline_m > 0.0 && (tracking || !points.empty())) {
+  const bool stereo = !input.right_image.empty() && input.baseline_m > 0.0;
+  if (stereo) {
     stereo_job = worker_->submit([&] {
       if (skip_stereo) return;
       const auto stereo_start = std::chrono::steady_clock::now();
-      points3d = stereo_points_by_id(gray, input.right_image, tracking ? klt_points() : points,
-                                     input.camera.pinhole, input.baseline_m, options_.stereo);
+      points3d = stereo_of(input, gray, tracking ? klt_points() : points);
       times.stereo_ms = ms_since(stereo_start);
     });
   }
@@ -193,8 +196,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   if (!keyframe_.valid) {
     redetect_job.get();
     stereo_job.get();
-    make_keyframe(input, tracking ? klt_points() : points, std::move(features),
-                  std::move(points3d));
+    make_keyframe(input, tracking ? klt_points() : points, std::move(points3d),
+                  std::move(features));
     r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
     r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
     r.reference_stamp = input.stamp;
@@ -242,8 +245,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       r.num_line_matches < options_.min_line_matches) {
     redetect_job.get();
     stereo_job.get();
-    make_keyframe(input, tracking ? klt_points() : points, std::move(features),
-                  std::move(points3d));
+    make_keyframe(input, tracking ? klt_points() : points, std::move(points3d),
+                  std::move(features));
     r.status = VoStatus::kTooFewFeatures;
     r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
@@ -322,26 +325,47 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     return r;
   }
 
-  // Scale: stereo points of the keyframe seen again, else the configured length.
+  // Scale: the keyframe's stereo points seen again, with this frame's disparities, fitted in
+  // disparity and image space (estimate_stereo_scale); without a usable fit, the configured
+  // length and scale_known false.
+  redetect_job.get();
+  stereo_job.get();
+  std::map<int64_t, Eigen::Vector3d> current3d = std::move(points3d);
   r.motion = est.pose;
-  double scale = options_.mono_scale;
-  if (!keyframe_.points3d.empty()) {
-    std::vector<Eigen::Vector3d> X;
-    std::vector<Eigen::Vector2d> x;
+  double scale = options_.mono_scale, scale_sigma = 0.0;
+  if (stereo) {
+    r.stereo_scale_attempted = true;
+    // The points were triangulated as Z = fx b / d.
+    const double fx_baseline = keyframe_.camera.pinhole.fx * input.baseline_m;
     for (size_t i = 0; i < m.points.size() && i < point_ids.size(); ++i) {
       if (i >= est.point_inliers.size() || !est.point_inliers[i]) continue;
       const auto it = keyframe_.points3d.find(point_ids[i]);
       if (it == keyframe_.points3d.end()) continue;
-      X.push_back(it->second);
-      x.push_back(input.camera.pinhole.normalize(m.points[i].x2));
+      StereoScaleObservation o;
+      o.x_ref = keyframe_.camera.pinhole.normalize(m.points[i].x1);
+      o.disparity_ref = fx_baseline / it->second.z();
+      o.x_cur = input.camera.pinhole.normalize(m.points[i].x2);
+      const auto now = current3d.find(point_ids[i]);
+      if (options_.stereo_current_disparity && now != current3d.end())
+        o.disparity_cur = input.camera.pinhole.fx * input.baseline_m / now->second.z();
+      r.scale_observations.push_back(o);
     }
-    double metric = 0.0;
-    if (scale_from_points(est.pose, X, x, &metric)) {
-      scale = metric;
+    const StereoRig rig{input.camera.pinhole.fx, input.camera.pinhole.fy, input.baseline_m};
+    offset_filter_.update(est.pose, rig, r.scale_observations, options_.stereo_scale);
+    StereoScaleOptions scale_options = options_.stereo_scale;
+    scale_options.disparity_offset_px = r.disparity_offset_px = offset_filter_.offset();
+    r.stereo_scale = estimate_stereo_scale(est.pose, rig, r.scale_observations, scale_options);
+    if (r.stereo_scale.status == StereoScaleStatus::kOk) {
+      scale = r.stereo_scale.scale;
+      scale_sigma = r.stereo_scale.sigma;
       r.scale_known = true;
     }
   }
   r.motion.t = est.pose.t * scale;
+  if (est.covariance_valid) {
+    r.motion_covariance = metric_motion_covariance(est.covariance, est.pose.t, scale, scale_sigma);
+    r.motion_covariance_valid = true;
+  }
 
   // Integrate: the current camera's centre in the keyframe is -R^T t.
   R_wc_ = nearest_rotation(keyframe_.R_wc * r.motion.R.transpose());
@@ -358,10 +382,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     }
     vp_tracker_.update(R_wc_, d2, weights);
   }
-  redetect_job.get();
-  stereo_job.get();
-  make_keyframe(input, tracking ? klt_points() : points, std::move(features),
-                std::move(points3d));
+  make_keyframe(input, tracking ? klt_points() : points, std::move(current3d),
+                std::move(features));
   r.status = VoStatus::kOk;
   r.message = "ok";
   r.total_ms = ms_since(start);

@@ -136,6 +136,9 @@ class VoNode {
   std::string last_problem_;
   int frames_ = 0, invalid_camera_info_ = 0, bad_images_ = 0, time_jumps_ = 0, failures_ = 0,
       dropped_ = 0, bad_features_ = 0;
+  // Stereo frames whose scale fell back to mono_scale, and the last reason.
+  int stereo_scale_fallbacks_ = 0;
+  std::string last_scale_fallback_;
 };
 
 }  // namespace hybrid_vo
