@@ -73,6 +73,74 @@ class SturmChain {
   int length_;
 };
 
+// The generic Sturm chain of a monic p of degree n, where every remainder has degree one less
+// than its divisor, as the three-term recurrence p_{k-1} = (a_k + b_k x) p_k - c_k p_{k+1}
+// (c_k > 0) from p_n (a constant) and p_{n-1} (linear). Evaluating the whole chain at x then
+// costs O(n) instead of one Horner pass per member, O(n^2); bisection evaluates it many times.
+// Degree drops (a common factor of p and p', or a remainder that vanishes to rounding) are
+// left to SturmChain.
+class ThreeTermSturmChain {
+ public:
+  // False when the chain is not generic; the object is then unusable.
+  bool build(const double* monic, int degree) {
+    n_ = degree;
+    double prev[kMax + 1], cur[kMax + 1], next[kMax + 1];
+    std::copy(monic, monic + degree + 1, prev);
+    for (int i = 1; i <= degree; ++i) cur[i - 1] = i * monic[i] / degree;
+    // prev has degree m + 1 and cur degree m, with leading coefficients +-1.
+    for (int m = degree - 1; m >= 1; --m) {
+      const double b = prev[m + 1] / cur[m];
+      const double a = (prev[m] - b * cur[m - 1]) / cur[m];
+      next[0] = prev[0] - a * cur[0];
+      for (int j = 1; j < m; ++j) next[j] = prev[j] - b * cur[j - 1] - a * cur[j];
+      // next is the remainder, of degree m - 1 unless its top coefficient vanishes against the
+      // dividend (SturmChain's test).
+      double scale = 0.0;
+      for (int j = 0; j <= m + 1; ++j) scale = std::max(scale, std::abs(prev[j]));
+      const double lead = std::abs(next[m - 1]);
+      if (!(lead > 1e-13 * scale)) return false;
+      const int k = degree - m;  // divisor p_k, remainder gives p_{k+1}
+      a_[k] = a;
+      b_[k] = b;
+      c_[k] = lead;
+      const double inv = -1.0 / lead;
+      for (int j = 0; j < m; ++j) prev[j] = cur[j];
+      prev[m] = cur[m];
+      for (int j = 0; j < m; ++j) cur[j] = next[j] * inv;
+    }
+    // cur is now p_n, a nonzero constant (+-1); prev is p_{n-1}, linear.
+    last_ = cur[0];
+    linear0_ = prev[0];
+    linear1_ = prev[1];
+    return true;
+  }
+
+  int sign_changes(double x) const {
+    double f_next = last_;                      // p_n
+    double f = linear0_ + linear1_ * x;         // p_{n-1}
+    int changes = 0;
+    double previous = f_next;                   // nonzero
+    auto count = [&](double v) {
+      if (v == 0.0) return;
+      changes += (v > 0.0) != (previous > 0.0);
+      previous = v;
+    };
+    count(f);
+    for (int k = n_ - 1; k >= 1; --k) {
+      const double g = (a_[k] + b_[k] * x) * f - c_[k] * f_next;  // p_{k-1}
+      f_next = f;
+      f = g;
+      count(f);
+    }
+    return changes;
+  }
+
+ private:
+  double a_[kMax + 1], b_[kMax + 1], c_[kMax + 1];
+  double last_ = 1.0, linear0_ = 0.0, linear1_ = 1.0;
+  int n_ = 0;
+};
+
 // Value and derivative of a polynomial at x.
 void evaluate_with_derivative(const double* c, int degree, double x, double* f, double* df) {
   double v = c[degree], d = 0.0;
@@ -159,6 +227,54 @@ int quadratic_roots(double B, double C, double* roots) {
   return 2;
 }
 
+// Isolates the distinct real roots of the monic polynomial in [-bound, bound] by bisection on
+// the Sturm counts of `chain`, then polishes each; ascending.
+template <typename Chain>
+int isolate_and_polish_roots(const Chain& chain, const double* monic, int degree, double bound,
+                             double* roots) {
+  struct Interval {
+    double lo, hi;
+    int changes_lo, changes_hi;
+  };
+  Interval stack[4 * kMax + 8];
+  int top = 0;
+  stack[top++] = {-bound, bound, chain.sign_changes(-bound), chain.sign_changes(bound)};
+  int found = 0;
+  int budget = 2000;  // bisections; only clusters of near-multiple roots come close.
+  while (top > 0 && found < degree && budget-- > 0) {
+    const Interval iv = stack[--top];
+    const int count = iv.changes_lo - iv.changes_hi;
+    if (count <= 0) continue;
+    const double width = iv.hi - iv.lo;
+    const double mid = 0.5 * (iv.lo + iv.hi);
+    if (width <= 1e-14 * std::max(1.0, std::abs(mid))) {
+      roots[found++] = mid;  // a multiple root, or roots closer than we can separate
+      continue;
+    }
+    if (count == 1) {
+      const double f_lo = horner(monic, degree, iv.lo);
+      const double f_hi = horner(monic, degree, iv.hi);
+      if (f_lo == 0.0) {
+        roots[found++] = iv.lo;
+        continue;
+      }
+      if ((f_lo > 0.0) != (f_hi > 0.0)) {
+        roots[found++] = polish_bracketed_root(monic, degree, iv.lo, iv.hi, f_lo);
+        continue;
+      }
+      // No sign change: an even-multiplicity root; keep bisecting on the Sturm counts.
+    }
+    const int changes_mid = chain.sign_changes(mid);
+    // Upper half first so that the lower half is popped first and roots come out ascending.
+    if (changes_mid - iv.changes_hi > 0 && top < 4 * kMax + 8)
+      stack[top++] = {mid, iv.hi, changes_mid, iv.changes_hi};
+    if (iv.changes_lo - changes_mid > 0 && top < 4 * kMax + 8)
+      stack[top++] = {iv.lo, mid, iv.changes_lo, changes_mid};
+  }
+  std::sort(roots, roots + found);
+  return found;
+}
+
 }  // namespace
 
 int real_roots_quartic(const double* c, double* roots) {
@@ -227,49 +343,11 @@ int real_roots(const double* c, int degree, double* roots) {
     return 1;
   }
 
-  const SturmChain chain(monic, degree);
   const double bound = root_bound(monic, degree);
-  struct Interval {
-    double lo, hi;
-    int changes_lo, changes_hi;
-  };
-  Interval stack[4 * kMax + 8];
-  int top = 0;
-  stack[top++] = {-bound, bound, chain.sign_changes(-bound), chain.sign_changes(bound)};
-  int found = 0;
-  int budget = 2000;  // bisections; only clusters of near-multiple roots come close.
-  while (top > 0 && found < degree && budget-- > 0) {
-    const Interval iv = stack[--top];
-    const int count = iv.changes_lo - iv.changes_hi;
-    if (count <= 0) continue;
-    const double width = iv.hi - iv.lo;
-    const double mid = 0.5 * (iv.lo + iv.hi);
-    if (width <= 1e-14 * std::max(1.0, std::abs(mid))) {
-      roots[found++] = mid;  // a multiple root, or roots closer than we can separate
-      continue;
-    }
-    if (count == 1) {
-      const double f_lo = horner(monic, degree, iv.lo);
-      const double f_hi = horner(monic, degree, iv.hi);
-      if (f_lo == 0.0) {
-        roots[found++] = iv.lo;
-        continue;
-      }
-      if ((f_lo > 0.0) != (f_hi > 0.0)) {
-        roots[found++] = polish_bracketed_root(monic, degree, iv.lo, iv.hi, f_lo);
-        continue;
-      }
-      // No sign change: an even-multiplicity root; keep bisecting on the Sturm counts.
-    }
-    const int changes_mid = chain.sign_changes(mid);
-    // Upper half first so that the lower half is popped first and roots come out ascending.
-    if (changes_mid - iv.changes_hi > 0 && top < 4 * kMax + 8)
-      stack[top++] = {mid, iv.hi, changes_mid, iv.changes_hi};
-    if (iv.changes_lo - changes_mid > 0 && top < 4 * kMax + 8)
-      stack[top++] = {iv.lo, mid, iv.changes_lo, changes_mid};
-  }
-  std::sort(roots, roots + found);
-  return found;
+  ThreeTermSturmChain generic;
+  if (generic.build(monic, degree))
+    return isolate_and_polish_roots(generic, monic, degree, bound, roots);
+  return isolate_and_polish_roots(SturmChain(monic, degree), monic, degree, bound, roots);
 }
 
 }  // namespace hybrid_vo
