@@ -20,27 +20,33 @@ int combine(int sign, int vote) {
 // The tests |d| < kNoParallax * scale below compare squares, which spares every square root.
 constexpr double kNoParallax2 = kNoParallax * kNoParallax;
 
-// tt = |t|^2. Written out in scalars: q = (x2, 1) saves a third of the products, and the
+// One point match as rays in camera 2's frame (or any rotation of it, applied to all three):
+// r = R x1 and q = x2, each up to a positive scale; tt = |t|^2. Written out in scalars, since the
 // minimal solvers call this several times per candidate pose.
-int vote_of_point(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double tt,
-                  const Eigen::Vector2d& x1, const Eigen::Vector2d& x2) {
-  // r = R (x1, 1), q = (x2, 1), n = r x q.
-  const double rx = R(0, 0) * x1.x() + R(0, 1) * x1.y() + R(0, 2);
-  const double ry = R(1, 0) * x1.x() + R(1, 1) * x1.y() + R(1, 2);
-  const double rz = R(2, 0) * x1.x() + R(2, 1) * x1.y() + R(2, 2);
-  const double qx = x2.x(), qy = x2.y();
-  const double nx = ry - rz * qy, ny = rz * qx - rx, nz = rx * qy - ry * qx;
+int vote_of_rays(double rx, double ry, double rz, double qx, double qy, double qz,
+                 const Eigen::Vector3d& t, double tt) {
+  const double nx = ry * qz - rz * qy, ny = rz * qx - rx * qz, nz = rx * qy - ry * qx;  // r x q
   // lambda1 * r + t = lambda2 * q, so lambda1 ~ (q x t).n and lambda2 ~ (r x t).n, both / |n|^2.
-  const double d1 = (qy * t.z() - t.y()) * nx + (t.x() - qx * t.z()) * ny + (qx * t.y() - qy * t.x()) * nz;
+  const double d1 = (qy * t.z() - qz * t.y()) * nx + (qz * t.x() - qx * t.z()) * ny +
+                    (qx * t.y() - qy * t.x()) * nz;
   const double d2 = (ry * t.z() - rz * t.y()) * nx + (rz * t.x() - rx * t.z()) * ny +
                     (rx * t.y() - ry * t.x()) * nz;
   const double nn = nx * nx + ny * ny + nz * nz;
   // (|n|^2 |t| |q| |r|)^2
-  const double scale2 = nn * nn * tt * (qx * qx + qy * qy + 1.0) * (rx * rx + ry * ry + rz * rz);
+  const double scale2 =
+      nn * nn * tt * (qx * qx + qy * qy + qz * qz) * (rx * rx + ry * ry + rz * rz);
   if (!(scale2 > 0.0)) return 0;
   if (d1 * d1 < kNoParallax2 * scale2 || d2 * d2 < kNoParallax2 * scale2) return 0;
   if ((d1 > 0.0) != (d2 > 0.0)) return kConflict;
   return d1 > 0.0 ? 1 : -1;
+}
+
+int vote_of_point(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double tt,
+                  const Eigen::Vector2d& x1, const Eigen::Vector2d& x2) {
+  const double rx = R(0, 0) * x1.x() + R(0, 1) * x1.y() + R(0, 2);
+  const double ry = R(1, 0) * x1.x() + R(1, 1) * x1.y() + R(1, 2);
+  const double rz = R(2, 0) * x1.x() + R(2, 1) * x1.y() + R(2, 2);
+  return vote_of_rays(rx, ry, rz, x2.x(), x2.y(), 1.0, t, tt);
 }
 
 // Depth of image point a (camera `from`) on the plane back-projected from line l of the other
@@ -92,6 +98,18 @@ int orient_translation_by_majority(const Eigen::Matrix3d& R, Eigen::Vector3d* t,
   }
   if (negative > positive) *t = -*t;
   return std::abs(positive - negative);
+}
+
+bool orient_translation_rays(const Eigen::Vector3d* r, const Eigen::Vector3d* q, int n,
+                             Eigen::Vector3d* t) {
+  int sign = 0;
+  const double tt = t->squaredNorm();
+  for (int i = 0; i < n && sign != kConflict; ++i)
+    sign = combine(sign, vote_of_rays(r[i].x(), r[i].y(), r[i].z(), q[i].x(), q[i].y(), q[i].z(),
+                                      *t, tt));
+  if (sign == kConflict) return false;
+  if (sign < 0) *t = -*t;
+  return true;
 }
 
 bool orient_translation(const Eigen::Matrix3d& R, Eigen::Vector3d* t, const MatchView& matches) {
