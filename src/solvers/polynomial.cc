@@ -187,20 +187,19 @@ double root_bound(const double* monic, int degree) {
 
 // Largest real root of the monic cubic x^3 + e2 x^2 + e1 x + e0.
 double largest_cubic_root(double e2, double e1, double e0) {
-  constexpr double kThird = 1.0 / 3.0, kTwentySeventh = 1.0 / 27.0;
-  const double P = e1 - e2 * e2 * kThird;
-  const double Q = 2.0 * e2 * e2 * e2 * kTwentySeventh - e2 * e1 * kThird + e0;
-  const double D = 0.25 * Q * Q + P * P * P * kTwentySeventh;
+  const double P = e1 - e2 * e2 / 3.0;
+  const double Q = 2.0 * e2 * e2 * e2 / 27.0 - e2 * e1 / 3.0 + e0;
+  const double D = 0.25 * Q * Q + P * P * P / 27.0;
   double t;
   if (D > 0.0) {
     const double u = std::cbrt(-0.5 * Q - std::copysign(std::sqrt(D), Q));
-    t = u != 0.0 ? u - P * kThird / u : 0.0;
+    t = u != 0.0 ? u - P / (3.0 * u) : 0.0;
   } else {
-    const double rho = std::sqrt(std::max(0.0, -P * kThird));
+    const double rho = std::sqrt(std::max(0.0, -P / 3.0));
     const double cos_arg = rho > 0.0 ? std::clamp(-0.5 * Q / (rho * rho * rho), -1.0, 1.0) : 0.0;
-    t = 2.0 * rho * std::cos(std::acos(cos_arg) * kThird);
+    t = 2.0 * rho * std::cos(std::acos(cos_arg) / 3.0);
   }
-  double x = t - e2 * kThird;
+  double x = t - e2 / 3.0;
   for (int i = 0; i < 2; ++i) {
     const double f = ((x + e2) * x + e1) * x + e0;
     const double df = (3.0 * x + 2.0 * e2) * x + e1;
