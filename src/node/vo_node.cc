@@ -145,7 +145,7 @@ void VoNode::load_parameters() {
     o.estimator.vp_detection.min_inliers = 6;
   }
   o.use_vp_tracker = pnh_.param("vp_tracker", true);
-  o.track_lines = pnh_.param("track_lines", true);
+  o.track_lines = pnh_.param("track_lines", false);
   o.klt.predict_motion = pnh_.param("klt_predict_motion", true);
   o.concurrent = pnh_.param("concurrent_frontend", true);
 }
