@@ -62,12 +62,16 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
 }
 
 void VisualOdometry::reset() {
-  klt_.reset();
-  vp_tracker_.reset();
-  keyframe_ = Keyframe();
+  restart();
   R_wc_.setIdentity();
   centre_.setZero();
   last_stamp_ = -1e300;
+}
+
+void VisualOdometry::restart() {
+  klt_.reset();
+  vp_tracker_.reset();
+  keyframe_ = Keyframe();
   tracker_seeded_ = false;
 }
 
