@@ -213,6 +213,7 @@ void VoNode::subscribe() {
 void VoNode::raw_image_callback(const sensor_msgs::ImageConstPtr& image) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_raw_image_ = ros::Time::now();
+  ++unsynced_images_;
 }
 
 VoNode::Frame& VoNode::pending(const ros::Time& stamp) {
@@ -231,6 +232,7 @@ void VoNode::mono_callback(const sensor_msgs::ImageConstPtr& image,
                            const sensor_msgs::CameraInfoConstPtr& info) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_synced_image_ = ros::Time::now();
+  unsynced_images_ = 0;
   Frame& f = pending(image->header.stamp);
   f.left = image;
   f.left_info = info;
@@ -245,6 +247,7 @@ void VoNode::stereo_callback(const sensor_msgs::ImageConstPtr& left,
                              const sensor_msgs::CameraInfoConstPtr& right_info) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_synced_image_ = ros::Time::now();
+  unsynced_images_ = 0;
   Frame& f = pending(left->header.stamp);
   f.left = left;
   f.left_info = left_info;
@@ -349,9 +352,8 @@ bool VoNode::reset_callback(std_srvs::Empty::Request&, std_srvs::Empty::Response
   return true;
 }
 
-bool VoNode::handle_stream_event(const Frame& frame, bool* lost) {
-  const StreamEvent event = monitor_.classify(frame.stamp.toSec(), static_cast<int>(frame.left->width),
-                                              static_cast<int>(frame.left->height));
+bool VoNode::handle_stream_event(const ros::Time& stamp, int width, int height, bool* lost) {
+  const StreamEvent event = monitor_.classify(stamp.toSec(), width, height);
   *lost = event == StreamEvent::kBackwards || restarts(event);
   const std::string& what = monitor_.description();
   {
@@ -378,8 +380,7 @@ bool VoNode::handle_stream_event(const Frame& frame, bool* lost) {
 }
 
 void VoNode::process(const Frame& frame) {
-  bool lost = false;
-  if (!handle_stream_event(frame, &lost)) return;
+  // Input checks first, so that a corrupt image's size or stamp never counts as a stream event.
   VisualOdometryInput input;
   input.stamp = frame.stamp.toSec();
   std::string reason;
@@ -412,6 +413,8 @@ void VoNode::process(const Frame& frame) {
                                  : lines_from_msg(*frame.lines, &input.external, &reason);
     if (!ok) return reject("features/lines", reason, &bad_features_);
   }
+  bool lost = false;
+  if (!handle_stream_event(frame.stamp, input.image.cols, input.image.rows, &lost)) return;
 
   const VisualOdometryResult result = vo_->process(input);
   monitor_.accept(input.image.cols, input.image.rows);
@@ -670,8 +673,9 @@ void VoNode::watchdog(const ros::TimerEvent&) {
     std::lock_guard<std::mutex> lock(mutex_);
     images_flow =
         !last_raw_image_.isZero() && (now - last_raw_image_).toSec() < camera_info_timeout_;
-    frames_flow =
-        !last_synced_image_.isZero() && (now - last_synced_image_).toSec() < camera_info_timeout_;
+    // A few images in a row, not one that is waiting for its camera_info after a pause.
+    frames_flow = unsynced_images_ < 3 || (!last_synced_image_.isZero() &&
+                                           (now - last_synced_image_).toSec() < camera_info_timeout_);
   }
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);

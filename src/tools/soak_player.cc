@@ -134,6 +134,14 @@ bool read_process(int pid, double* rss_mb, double* cpu_s) {
   return true;
 }
 
+// The machine's 1-minute load average (other processes compete for the cores).
+double load_average() {
+  std::ifstream in("/proc/loadavg");
+  double load = 0.0;
+  in >> load;
+  return load;
+}
+
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   const size_t k = std::min(v.size() - 1, static_cast<size_t>(q * (v.size() - 1) + 0.5));
@@ -231,7 +239,7 @@ class Player {
     if (!o_.csv.empty()) {
       csv.open(o_.csv);
       csv << "time_s,frames_sent,frames_answered,queue_drops,rss_mb,cpu_percent,"
-             "latency_p50_ms,latency_p99_ms,latency_max_ms,answers_per_s\n";
+             "latency_p50_ms,latency_p99_ms,latency_max_ms,answers_per_s,load1\n";
     }
     start_ = Clock::now();
     Clock::time_point next_sample = start_;
@@ -253,16 +261,19 @@ class Player {
       const double dt = t - last_sample_t;
       const double cpu_percent = alive && have_cpu && dt > 0 ? 100.0 * (cpu - last_cpu) / dt : 0.0;
       const double rate = dt > 0 ? (answered - last_answered) / dt : 0.0;
+      const double load = load_average();
       if (t > 0) {
         samples_t_.push_back(t);
         samples_rss_.push_back(rss);
         samples_cpu_.push_back(cpu_percent);
+        samples_load_.push_back(load);
       }
       if (csv.is_open()) {
         char row[256];
-        std::snprintf(row, sizeof(row), "%.1f,%d,%d,%d,%.2f,%.1f,%.2f,%.2f,%.2f,%.2f\n", t, sent_,
-                      answered, drops, rss, cpu_percent, quantile(window, 0.5),
-                      quantile(window, 0.99), window.empty() ? 0.0 : quantile(window, 1.0), rate);
+        std::snprintf(row, sizeof(row), "%.1f,%d,%d,%d,%.2f,%.1f,%.2f,%.2f,%.2f,%.2f,%.2f\n", t,
+                      sent_, answered, drops, rss, cpu_percent, quantile(window, 0.5),
+                      quantile(window, 0.99), window.empty() ? 0.0 : quantile(window, 1.0), rate,
+                      load);
         csv << row << std::flush;
       }
       last_cpu = cpu;
@@ -353,18 +364,27 @@ class Player {
       t.push_back(samples_t_[i] / 3600.0);
       rss.push_back(samples_rss_[i]);
     }
-    double cpu_mean = 0.0;
+    double cpu_mean = 0.0, load_mean = 0.0;
     for (double c : samples_cpu_) cpu_mean += c / std::max<size_t>(1, samples_cpu_.size());
+    for (double l : samples_load_) load_mean += l / std::max<size_t>(1, samples_load_.size());
     const double duration = samples_t_.empty() ? 0.0 : samples_t_.back();
     std::lock_guard<std::mutex> lock(mutex_);
     const int answered = static_cast<int>(answers_.size());
+    const double p99 = quantile(steady_latencies_, 0.99);
+    // Fed at a rate: the latency in frame periods. In lock-step: the sustainable rate, at which
+    // 95 % of the frames are done before the next one comes (each cycle is one latency).
+    const std::string rate_field =
+        o_.rate > 0 ? "latency_p99_periods=" + std::to_string(p99 * o_.rate / 1000.0)
+                    : "sustainable_hz=" +
+                          std::to_string(1000.0 / std::max(1e-3, quantile(steady_latencies_, 0.95)));
     std::printf(
         "summary: frames=%d dropped=%d rss_start_mb=%.1f rss_end_mb=%.1f "
         "rss_slope_mb_per_h=%.2f latency_p50_ms=%.1f latency_p99_ms=%.1f rate_hz=%.2f "
-        "cpu_percent=%.1f ok=%d queue_drops=%d duration_s=%.0f warmup_s=%.0f\n",
+        "cpu_percent=%.1f ok=%d queue_drops=%d duration_s=%.0f warmup_s=%.0f load1=%.1f %s\n",
         sent_, sent_ - answered, rss.empty() ? 0.0 : rss.front(), rss.empty() ? 0.0 : rss.back(),
-        slope(t, rss), quantile(steady_latencies_, 0.5), quantile(steady_latencies_, 0.99),
-        duration > 0 ? answered / duration : 0.0, cpu_mean, ok_, queue_drops_, duration, warmup_s_);
+        slope(t, rss), quantile(steady_latencies_, 0.5), p99,
+        duration > 0 ? answered / duration : 0.0, cpu_mean, ok_, queue_drops_, duration, warmup_s_,
+        load_mean, rate_field.c_str());
     std::fflush(stdout);
   }
 
@@ -383,7 +403,7 @@ class Player {
   std::map<ros::Time, double> answers_;  // stamp -> latency (ms)
   std::vector<double> window_latencies_, steady_latencies_;
   int sent_ = 0, ok_ = 0, queue_drops_ = 0;
-  std::vector<double> samples_t_, samples_rss_, samples_cpu_;
+  std::vector<double> samples_t_, samples_rss_, samples_cpu_, samples_load_;
 };
 
 }  // namespace

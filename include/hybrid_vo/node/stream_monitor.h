@@ -41,12 +41,13 @@ class StreamMonitor {
  public:
   explicit StreamMonitor(const StreamMonitorOptions& options = {}) : options_(options) {}
 
-  // What the next frame is, counted. Every frame that is not skipped becomes the reference for the
-  // next frame's stamp checks, whether it is then processed or rejected.
+  // What the next valid frame is, counted. Every frame that is not skipped becomes the reference
+  // for the next frame's stamp checks. (The node rejects corrupt input before it gets here, so
+  // that a broken message's stamp or size never counts as an event.)
   StreamEvent classify(double stamp, int width, int height);
   // The frame was processed: its size is the reference for the next size check.
   void accept(int width, int height);
-  // The frame was rejected: the next frame restarts the chain, so that no motion is estimated
+  // Input was rejected: the next frame restarts the chain, so that no motion is estimated
   // across the bad input.
   void reject() { restart_pending_ = true; }
   // Forgets the stream (reset service, bag loop); the counters stay.

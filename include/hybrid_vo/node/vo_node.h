@@ -79,8 +79,9 @@ class VoNode {
   // The processing thread: frames from the queue, one at a time, in arrival order.
   void run();
   void process(const Frame& frame);
-  // Resets or restarts the odometry for a fault in the stream; false to skip the frame.
-  bool handle_stream_event(const Frame& frame, bool* lost);
+  // Resets or restarts the odometry for a fault in the stream (a valid frame of this stamp and
+  // size); false to skip the frame.
+  bool handle_stream_event(const ros::Time& stamp, int width, int height, bool* lost);
   void publish(const Frame& frame, const VisualOdometryInput& input,
                const VisualOdometryResult& result, bool lost);
   // `lost`: the pose follows a fault in the stream, so its covariance says "unknown" (9999, as
@@ -156,6 +157,7 @@ class VoNode {
   double min_frequency_ = 1.0, max_frequency_ = 100.0;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
   ros::Time last_raw_image_, last_synced_image_;
+  int unsynced_images_ = 0;  // images since the last synchronised frame
   ros::Time last_processed_;
   VisualOdometryResult last_result_;
   std::string last_problem_;
