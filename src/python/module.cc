@@ -1,0 +1,16 @@
+// hybrid_vo._core: the core library (solvers, estimator, VP detection, synthetic data) for
+// Python. python/hybrid_vo/__init__.py re-exports it as the package hybrid_vo.
+#include "bindings.h"
+
+PYBIND11_MODULE(_core, m) {
+  namespace python = hybrid_vo::python;
+  // Docstrings carry their own "name(args)\n--\n\n" signature line, which CPython turns into
+  // __text_signature__ (inspect.signature, help) with the real defaults.
+  pybind11::options options;
+  options.disable_function_signatures();
+  m.doc() = "hybrid_vo core bindings; use the package hybrid_vo.";
+  python::bind_solvers(m);
+  python::bind_estimator(m);
+  python::bind_vanishing_points(m);
+  python::bind_synthetic(m);
+}

@@ -1,0 +1,21 @@
+"""Shared fixtures of the Python binding tests (run by scripts/test after sourcing the devel
+space, so that `import hybrid_vo` finds the built module)."""
+import os
+import pathlib
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def data_dir():
+    """The shared real data: $HYBRID_VO_DATA, else ../shared/data beside the checkout."""
+    return pathlib.Path(os.environ.get("HYBRID_VO_DATA", ROOT.parent / "shared" / "data"))
+
+
+@pytest.fixture(scope="session")
+def kitti():
+    path = data_dir() / "kitti_seq0x_51"
+    if not path.exists():
+        pytest.skip(f"{path} not present")
+    return path
