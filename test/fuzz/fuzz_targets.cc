@@ -423,25 +423,21 @@ sensor_msgs::PointCloud point_cloud(ByteReader* r) {
   return msg;
 }
 
-Outcome vins_points(const uint8_t* data, size_t size) {
+// Both VINS encodings share one message type; `lines` picks the conversion.
+Outcome vins(const uint8_t* data, size_t size, bool lines) {
   ByteReader r(data, size);
   const sensor_msgs::PointCloud msg = point_cloud(&r);
   ExternalFeatures f;
   std::string error;
-  Outcome o = message_outcome(points_from_vins(msg, vins_camera(), &f, &error), error);
-  check_external(&o, f, false);
+  const bool ok = lines ? lines_from_vins(msg, vins_camera(), &f, &error)
+                        : points_from_vins(msg, vins_camera(), &f, &error);
+  Outcome o = message_outcome(ok, error);
+  check_external(&o, f, lines);
   return o;
 }
 
-Outcome vins_lines(const uint8_t* data, size_t size) {
-  ByteReader r(data, size);
-  const sensor_msgs::PointCloud msg = point_cloud(&r);
-  ExternalFeatures f;
-  std::string error;
-  Outcome o = message_outcome(lines_from_vins(msg, vins_camera(), &f, &error), error);
-  check_external(&o, f, true);
-  return o;
-}
+Outcome vins_points(const uint8_t* data, size_t size) { return vins(data, size, false); }
+Outcome vins_lines(const uint8_t* data, size_t size) { return vins(data, size, true); }
 
 Outcome camera_info(const uint8_t* data, size_t size) {
   ByteReader r(data, size);
