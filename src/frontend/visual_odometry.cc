@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 
 #include <opencv2/imgproc.hpp>
 
@@ -51,7 +52,8 @@ const char* to_string(VoStatus status) {
 }
 
 VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
-    : options_(options), klt_(options.klt), vp_tracker_(options.vp_tracker) {
+    : options_(options), klt_(options.klt), vp_tracker_(options.vp_tracker),
+      offset_filter_(options.stereo_offset) {
   if (options_.use_vp_tracker) {
     // The tracker feeds d1 from directions averaged over many frames: trust them as given (they
     // pin the rotation to the tracked Manhattan frame, which stops rotational drift) rather than
@@ -75,23 +77,11 @@ void VisualOdometry::restart() {
   tracker_seeded_ = false;
 }
 
-void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
-                                   const std::map<int64_t, Eigen::Vector2d>& points,
-                                   ImageFeatures features) {
-  keyframe_ = Keyframe();
-  keyframe_.valid = true;
-  keyframe_.stamp = input.stamp;
-  keyframe_.points = points;
-  keyframe_.features = std::move(features);
-  keyframe_.camera = input.camera;
-  keyframe_.R_wc = R_wc_;
-  keyframe_.centre = centre_;
-  if (input.external.has_lines)
-    for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i)
-      keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];
-  keyframe_.points_undistorted = input.external.has_points && input.external.points_undistorted;
-  keyframe_.lines_undistorted = input.external.has_lines && input.external.lines_undistorted;
-  // Stereo: metric 3D points of the keyframe's features, for the scale of the next motion.
+std::map<int64_t, Eigen::Vector3d> VisualOdometry::stereo_of(
+    const VisualOdometryInput& input, const cv::Mat& gray,
+    const std::map<int64_t, Eigen::Vector2d>& points) const {
+  // Stereo: metric 3D points of the frame's features, for the scale of this and the next motion.
+  std::map<int64_t, Eigen::Vector3d> points3d;
   if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
     std::vector<int64_t> ids;
     std::vector<Eigen::Vector2d> pixels;
@@ -104,8 +94,29 @@ void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::M
         gray, to_gray8(input.right_image), pixels, input.camera.pinhole, input.baseline_m, &valid,
         options_.stereo);
     for (size_t i = 0; i < ids.size(); ++i)
-      if (valid[i]) keyframe_.points3d[ids[i]] = X[i];
+      if (valid[i]) points3d[ids[i]] = X[i];
   }
+  return points3d;
+}
+
+void VisualOdometry::make_keyframe(const VisualOdometryInput& input,
+                                   const std::map<int64_t, Eigen::Vector2d>& points,
+                                   std::map<int64_t, Eigen::Vector3d> points3d,
+                                   ImageFeatures features) {
+  keyframe_ = Keyframe();
+  keyframe_.valid = true;
+  keyframe_.stamp = input.stamp;
+  keyframe_.points = points;
+  keyframe_.points3d = std::move(points3d);
+  keyframe_.features = std::move(features);
+  keyframe_.camera = input.camera;
+  keyframe_.R_wc = R_wc_;
+  keyframe_.centre = centre_;
+  if (input.external.has_lines)
+    for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i)
+      keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];
+  keyframe_.points_undistorted = input.external.has_points && input.external.points_undistorted;
+  keyframe_.lines_undistorted = input.external.has_lines && input.external.lines_undistorted;
 }
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
@@ -143,11 +154,17 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       points[static_cast<int64_t>(i)] = Eigen::Vector2d(features.points.keypoints[i].pt.x,
                                                         features.points.keypoints[i].pt.y);
   }
+  // Stereo matching of this frame runs on the second core while segments are detected and the
+  // pose is estimated (it is needed only for the scale and the next keyframe).
+  const bool stereo = !input.right_image.empty() && input.baseline_m > 0.0;
+  std::future<std::map<int64_t, Eigen::Vector3d>> stereo_points_of_frame = std::async(
+      stereo ? std::launch::async : std::launch::deferred,
+      [this, &input, &gray, &points] { return stereo_of(input, gray, points); });
   if (options_.use_lines && !input.external.has_lines)
     features.lines = detect_line_features(gray, options_.features.lines);
 
   if (!keyframe_.valid) {
-    make_keyframe(input, gray, points, std::move(features));
+    make_keyframe(input, points, stereo_points_of_frame.get(), std::move(features));
     r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
     r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
     r.reference_stamp = input.stamp;
@@ -186,7 +203,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
 
   if (r.num_point_matches < options_.min_point_matches &&
       r.num_line_matches < options_.min_line_matches) {
-    make_keyframe(input, gray, points, std::move(features));
+    make_keyframe(input, points, stereo_points_of_frame.get(), std::move(features));
     r.status = VoStatus::kTooFewFeatures;
     r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
@@ -255,26 +272,45 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     return r;
   }
 
-  // Scale: stereo points of the keyframe seen again, else the configured length.
+  // Scale: the keyframe's stereo points seen again, with this frame's disparities, fitted in
+  // disparity and image space (estimate_stereo_scale); without a usable fit, the configured
+  // length and scale_known false.
+  std::map<int64_t, Eigen::Vector3d> current3d = stereo_points_of_frame.get();
   r.motion = est.pose;
-  double scale = options_.mono_scale;
-  if (!keyframe_.points3d.empty()) {
-    std::vector<Eigen::Vector3d> X;
-    std::vector<Eigen::Vector2d> x;
+  double scale = options_.mono_scale, scale_sigma = 0.0;
+  if (stereo) {
+    r.stereo_scale_attempted = true;
+    // The points were triangulated as Z = fx b / d.
+    const double fx_baseline = keyframe_.camera.pinhole.fx * input.baseline_m;
     for (size_t i = 0; i < m.points.size() && i < point_ids.size(); ++i) {
       if (i >= est.point_inliers.size() || !est.point_inliers[i]) continue;
       const auto it = keyframe_.points3d.find(point_ids[i]);
       if (it == keyframe_.points3d.end()) continue;
-      X.push_back(it->second);
-      x.push_back(input.camera.pinhole.normalize(m.points[i].x2));
+      StereoScaleObservation o;
+      o.x_ref = keyframe_.camera.pinhole.normalize(m.points[i].x1);
+      o.disparity_ref = fx_baseline / it->second.z();
+      o.x_cur = input.camera.pinhole.normalize(m.points[i].x2);
+      const auto now = current3d.find(point_ids[i]);
+      if (options_.stereo_current_disparity && now != current3d.end())
+        o.disparity_cur = input.camera.pinhole.fx * input.baseline_m / now->second.z();
+      r.scale_observations.push_back(o);
     }
-    double metric = 0.0;
-    if (scale_from_points(est.pose, X, x, &metric)) {
-      scale = metric;
+    const StereoRig rig{input.camera.pinhole.fx, input.camera.pinhole.fy, input.baseline_m};
+    offset_filter_.update(est.pose, rig, r.scale_observations, options_.stereo_scale);
+    StereoScaleOptions scale_options = options_.stereo_scale;
+    scale_options.disparity_offset_px = r.disparity_offset_px = offset_filter_.offset();
+    r.stereo_scale = estimate_stereo_scale(est.pose, rig, r.scale_observations, scale_options);
+    if (r.stereo_scale.status == StereoScaleStatus::kOk) {
+      scale = r.stereo_scale.scale;
+      scale_sigma = r.stereo_scale.sigma;
       r.scale_known = true;
     }
   }
   r.motion.t = est.pose.t * scale;
+  if (est.covariance_valid) {
+    r.motion_covariance = metric_motion_covariance(est.covariance, est.pose.t, scale, scale_sigma);
+    r.motion_covariance_valid = true;
+  }
 
   // Integrate: the current camera's centre in the keyframe is -R^T t.
   R_wc_ = nearest_rotation(keyframe_.R_wc * r.motion.R.transpose());
@@ -291,7 +327,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     }
     vp_tracker_.update(R_wc_, d2, weights);
   }
-  make_keyframe(input, gray, points, std::move(features));
+  make_keyframe(input, points, std::move(current3d), std::move(features));
   r.status = VoStatus::kOk;
   r.message = "ok";
   r.total_ms = ms_since(start);

@@ -151,6 +151,9 @@ void VoNode::load_parameters() {
   o.features.points.max_features = o.klt.max_features;
   o.min_parallax_px = pnh_.param("min_parallax_px", 2.0);
   o.mono_scale = pnh_.param("mono_scale", 1.0);
+  o.stereo_scale.max_depth_baselines =
+      pnh_.param("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines);
+  o.stereo_offset.enabled = pnh_.param("stereo_offset_calibration", o.stereo_offset.enabled);
   o.estimator.estimator.ransac.point_threshold_px = pnh_.param("point_threshold_px", 1.0);
   o.estimator.estimator.ransac.vp_threshold_deg = pnh_.param("vp_threshold_deg", 2.0);
   o.estimator.vp_detection.inlier_threshold_px = pnh_.param("vp_inlier_threshold_px", 2.0);
@@ -434,6 +437,13 @@ void VoNode::process(const Frame& frame) {
       ROS_WARN_THROTTLE(2.0, "hybrid_vo: %s", last_problem_.c_str());
     }
   }
+  if (result.stereo_scale_attempted && !result.scale_known) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stereo_scale_fallbacks_;
+    last_scale_fallback_ = to_string(result.stereo_scale.status);
+    ROS_WARN_THROTTLE(5.0, "hybrid_vo: stereo scale: %s (%d near points); mono_scale used",
+                      last_scale_fallback_.c_str(), result.stereo_scale.near_points);
+  }
   publish(frame, input, result, lost);
   const double latency_ms = std::chrono::duration<double, std::milli>(
                                 std::chrono::steady_clock::now() - frame.received)
@@ -460,14 +470,10 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
   rel.transform = moved ? to_transform(result.motion.R, result.motion.t)
                         : to_transform(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
   rel.scale_known = moved && result.scale_known;
-  if (moved && est.covariance_valid) {
-    // The covariance is of the unit translation; a known scale scales its translation block.
-    Eigen::Matrix<double, 6, 6> cov = est.covariance;
-    const double s = result.motion.t.norm();
-    cov.block<3, 3>(3, 3) *= s * s;
-    cov.block<3, 3>(0, 3) *= s;
-    cov.block<3, 3>(3, 0) *= s;
-    for (int i = 0; i < 36; ++i) rel.covariance[i] = cov(i / 6, i % 6);
+  if (moved && result.motion_covariance_valid) {
+    // The estimator's covariance for the translation as published, with a stereo scale's
+    // uncertainty along t.
+    for (int i = 0; i < 36; ++i) rel.covariance[i] = result.motion_covariance(i / 6, i % 6);
   }
   rel.points = result.num_point_matches;
   rel.lines = result.num_line_matches;
@@ -727,6 +733,14 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("line inliers", est.num_line_inliers);
   status.add("VP inliers", est.num_vp_inliers);
   status.add("scale known", r.scale_known);
+  if (r.stereo_scale_attempted) {
+    status.add("stereo scale", to_string(r.stereo_scale.status));
+    status.add("stereo scale sigma (m)", r.stereo_scale.sigma);
+    status.add("stereo near points", r.stereo_scale.near_points);
+    status.add("disparity offset (px)", r.disparity_offset_px);
+  }
+  status.add("stereo scale fallbacks", stereo_scale_fallbacks_);
+  if (!last_scale_fallback_.empty()) status.add("last stereo scale fallback", last_scale_fallback_);
   status.add("front end (ms)", r.frontend_ms);
   status.add("estimator (ms)", r.estimator_ms);
   status.add("invalid camera_info", invalid_camera_info_);

@@ -185,7 +185,10 @@ int main(int argc, char** argv) {
   // Per-pair errors: the node's own relative poses when recorded, else consecutive poses.
   std::vector<double> errors;
   int failures = 0, skipped = 0;
-  std::printf("pair,stamp_ref,stamp,status,rot_err_deg,dir_err_deg\n");
+  // With a metric scale, the ratio of the estimated to the true translation length per pair: a
+  // scale bias shows at a glance, not only through the drift.
+  std::vector<double> scale_ratios;
+  std::printf("pair,stamp_ref,stamp,status,rot_err_deg,dir_err_deg,scale_ratio\n");
   if (!run.motions.empty()) {
     for (const hybrid_vo::MotionEstimate& m : run.motions) {
       if (m.status == hybrid_vo::MotionEstimate::STATUS_SKIPPED) {
@@ -196,7 +199,7 @@ int main(int argc, char** argv) {
       if (!hybrid_vo::tools::pose_at(gt, m.reference_stamp.toSec(), tolerance, &a) ||
           !hybrid_vo::tools::pose_at(gt, m.header.stamp.toSec(), tolerance, &b))
         continue;
-      double rot = 180.0, dir = 180.0;
+      double rot = 180.0, dir = 180.0, ratio = NAN;
       if (m.status == hybrid_vo::MotionEstimate::STATUS_OK) {
         const auto& q = m.transform.rotation;
         const Eigen::Matrix3d R = Eigen::Quaterniond(q.w, q.x, q.y, q.z).normalized().toRotationMatrix();
@@ -206,12 +209,18 @@ int main(int argc, char** argv) {
         const Eigen::Vector3d t_gt = b.R.transpose() * (a.c - b.c);
         rot = hybrid_vo::rotation_error(R, R_gt) * kDeg;
         dir = hybrid_vo::translation_error(t, t_gt) * kDeg;
+        if (m.scale_known && t_gt.norm() > 1e-9) {
+          ratio = t.norm() / t_gt.norm();
+          scale_ratios.push_back(ratio);
+        }
       } else {
         ++failures;
       }
       errors.push_back(std::max(rot, dir));
-      std::printf("%zu,%.6f,%.6f,%d,%.4f,%.4f\n", errors.size() - 1, m.reference_stamp.toSec(),
+      std::printf("%zu,%.6f,%.6f,%d,%.4f,%.4f,", errors.size() - 1, m.reference_stamp.toSec(),
                   m.header.stamp.toSec(), m.status, rot, dir);
+      if (std::isfinite(ratio)) std::printf("%.4f", ratio);
+      std::printf("\n");
     }
   }
   const bool with_scale = run.scale_known * 2 < static_cast<int>(run.motions.size()) || run.motions.empty();
@@ -221,7 +230,7 @@ int main(int argc, char** argv) {
   if (run.motions.empty()) {
     for (size_t i = 0; i < te.rot_err_deg.size(); ++i) {
       errors.push_back(std::max(te.rot_err_deg[i], te.dir_err_deg[i]));
-      std::printf("%zu,,,0,%.4f,%.4f\n", i, te.rot_err_deg[i], te.dir_err_deg[i]);
+      std::printf("%zu,,,0,%.4f,%.4f,\n", i, te.rot_err_deg[i], te.dir_err_deg[i]);
     }
   }
   if (!plot.empty() && !aligned.empty()) {
@@ -251,6 +260,11 @@ int main(int argc, char** argv) {
               "drift %.2f %% and %.3f deg/100 m over %d segments\n",
               failures, skipped, te.pairs + 1, with_scale ? "aligned" : "metric", te.scale,
               te.drift_trans_percent, te.drift_rot_deg_per_100m, te.drift_segments);
+  if (!scale_ratios.empty())
+    std::printf("# scale ratio (estimated / true translation length): median %.4f (p10 %.4f, "
+                "p90 %.4f) over %zu metric pairs\n",
+                median(scale_ratios), hybrid_vo::tools::percentile(scale_ratios, 0.1),
+                hybrid_vo::tools::percentile(scale_ratios, 0.9), scale_ratios.size());
   // Processing time per frame as the node measured it (MotionEstimate), skipped frames included:
   // what bounds the frame rate through the node.
   std::vector<double> frontend_ms, estimator_ms, total_ms;

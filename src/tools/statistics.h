@@ -17,5 +17,12 @@ inline double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// The p-quantile (0..1) by the nearest rank; NaN when empty.
+inline double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(p * (v.size() - 1) + 0.5))];
+}
+
 }  // namespace tools
 }  // namespace hybrid_vo

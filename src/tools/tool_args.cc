@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <iostream>
 #include <sstream>
 
 namespace hybrid_vo {
@@ -41,6 +42,14 @@ bool parse_camera(const std::string& text, CameraModel* camera, std::string* err
   }
   *camera = c;
   return true;
+}
+
+std::string option_value(int argc, char** argv, int* i) {
+  if (*i + 1 >= argc) {
+    std::cerr << "error: " << argv[*i] << " needs a value\n";
+    std::exit(2);
+  }
+  return argv[++*i];
 }
 
 }  // namespace tools

@@ -17,5 +17,9 @@ bool parse_camera(const std::string& text, CameraModel* camera, std::string* err
 // Comma-separated list ("a,b,c"); empty items are dropped.
 std::vector<std::string> split_list(const std::string& text);
 
+// The value after the option argv[*i], advancing *i; a missing value prints an error and exits
+// with status 2 (the tools' usage-error status).
+std::string option_value(int argc, char** argv, int* i);
+
 }  // namespace tools
 }  // namespace hybrid_vo

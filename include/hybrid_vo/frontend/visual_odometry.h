@@ -10,6 +10,7 @@
 
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/klt_tracker.h"
+#include "hybrid_vo/estimation/stereo_scale.h"
 #include "hybrid_vo/frontend/stereo.h"
 #include "hybrid_vo/lines/two_view.h"
 #include "hybrid_vo/lines/vp_tracker.h"
@@ -36,6 +37,9 @@ struct VisualOdometryOptions {
   int min_line_matches = 12;
   double mono_scale = 1.0;    // length given to a unit translation without stereo
   StereoOptions stereo;
+  StereoScaleOptions stereo_scale;  // the metric scale from the keyframe's stereo points
+  DisparityOffsetOptions stereo_offset;  // self-calibration of a constant disparity offset
+  bool stereo_current_disparity = true;  // fit the current frame's disparities too
   bool use_vp_tracker = true;
   VpTrackerOptions vp_tracker;
   // Weight of a VP residual in the final refinement when the tracker feeds the VPs (1: one radian
@@ -83,6 +87,16 @@ struct VisualOdometryResult {
   TwoViewEstimate estimate;
   RelativePose motion;           // X_cur = R X_ref + t, t scaled (metric when scale_known)
   bool scale_known = false;
+  // Covariance of [rotation (left increment, rad), t as in `motion`]: the estimator's, with the
+  // translation block scaled and, with a stereo scale, its variance along t added.
+  Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  bool motion_covariance_valid = false;
+  // Stereo input: the scale fit and its inputs (inlier points of the keyframe with a disparity,
+  // seen again). Without a usable fit t has the length mono_scale and scale_known is false.
+  bool stereo_scale_attempted = false;
+  StereoScaleEstimate stereo_scale;
+  std::vector<StereoScaleObservation> scale_observations;
+  double disparity_offset_px = 0.0;  // the offset applied (0 until self-calibration is sure)
   Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
@@ -121,12 +135,19 @@ class VisualOdometry {
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   };
 
-  void make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
-                     const std::map<int64_t, Eigen::Vector2d>& points, ImageFeatures features);
+  // Stereo points of the frame's features by id (empty without a right image).
+  std::map<int64_t, Eigen::Vector3d> stereo_of(const VisualOdometryInput& input,
+                                               const cv::Mat& gray,
+                                               const std::map<int64_t, Eigen::Vector2d>& points) const;
+  void make_keyframe(const VisualOdometryInput& input,
+                     const std::map<int64_t, Eigen::Vector2d>& points,
+                     std::map<int64_t, Eigen::Vector3d> points3d, ImageFeatures features);
 
   VisualOdometryOptions options_;
   KltTracker klt_;
   VpTracker vp_tracker_;
+  // Kept across reset(): the offset belongs to the rig, not to the trajectory.
+  DisparityOffsetFilter offset_filter_;
   Keyframe keyframe_;
   Eigen::Matrix3d R_wc_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();

@@ -166,6 +166,9 @@ class VoNode {
   bool camera_info_outage_ = false;
   StreamCounters stream_counters_;
   LatencyWindow latency_ms_;
+  // Stereo frames whose scale fell back to mono_scale, and the last reason.
+  int stereo_scale_fallbacks_ = 0;
+  std::string last_scale_fallback_;
 };
 
 }  // namespace hybrid_vo
