@@ -3,7 +3,6 @@
 // long segments through the Manhattan VPs), the walk, and option checking.
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -545,15 +544,6 @@ TEST(RenderOptions, InvalidSceneCameraAndPathAreRejected) {
   CameraPose not_rotation = pose;
   not_rotation.R_world_from_camera *= 2.0;
   EXPECT_THROW(render_view(scene, cam, not_rotation), std::invalid_argument);
-}
-
-TEST_F(RenderTest, RendersQuickly) {
-  const auto start = std::chrono::steady_clock::now();
-  render_frame(seq(), 50);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  RecordProperty("render_ms", static_cast<int>(seconds * 1000));
-  EXPECT_LT(seconds, 2.0);  // about 0.2 s on two cores; loose for loaded CI machines
 }
 
 }  // namespace
