@@ -2,7 +2,11 @@
 // and a message that names the problem, never a crash or a made-up pose.
 #include <array>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 #include <sys/wait.h>
 
 #include <gtest/gtest.h>
@@ -67,6 +71,49 @@ TEST(EvalPairsCli, MissingDataSet) {
 TEST(EvalPairsCli, BadOptionValues) {
   expect_error(run("hybrid_vo_eval_pairs", "--format kitti /tmp --runs 0"), "--runs");
   expect_error(run("hybrid_vo_eval_pairs", "--format kitti /tmp --presets bogus"), "bogus");
+  expect_error(run("hybrid_vo_eval_pairs", "--format kitti /tmp --max-points 0"), "--max-points");
+  expect_error(run("hybrid_vo_eval_pairs", "--format kitti /tmp --max-points 2x"), "--max-points");
+  expect_error(run("hybrid_vo_eval_pairs", "--format kitti /tmp --point-selection grid"),
+               "--point-selection");
+}
+
+// On the shared KITTI frames when present: every run of every method sees exactly N points.
+TEST(EvalPairsCli, MaxPointsKeepsExactlyNMatches) {
+  // ../shared/data from the checkout, as the data sets' README says, or $HYBRID_VO_DATA.
+  const char* env = std::getenv("HYBRID_VO_DATA");
+  const std::string data =
+      (env ? std::string(env) : std::string(HYBRID_VO_SOURCE_DIR) + "/../shared/data") +
+      "/kitti_seq0x_51";
+  if (!std::ifstream(data + "/sequences/seq0x/times.txt")) GTEST_SKIP() << data << " not present";
+  const std::string csv = testing::TempDir() + "/eval_pairs_max_points.csv";
+  const Outcome o = run("hybrid_vo_eval_pairs", "--format kitti " + data +
+                                                    " --max-pairs 2 --runs 2 --presets "
+                                                    "5pc,hybrid,opencv_usac_magsac --max-points "
+                                                    "20,all --point-selection random,clustered "
+                                                    "--csv " + csv);
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("max_points,selection,method,auc5"), std::string::npos) << o.output;
+  EXPECT_NE(o.output.find("20,clustered,hybrid,"), std::string::npos) << o.output;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  int limited = 0, all = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+    ASSERT_EQ(fields.size(), 13u) << line;
+    const int points = std::stoi(fields[7]);
+    if (fields[11] == "20") {
+      EXPECT_EQ(points, 20) << line;
+      ++limited;
+    } else {
+      EXPECT_GT(points, 100) << line;
+      ++all;
+    }
+  }
+  EXPECT_EQ(limited, 2 * 2 * 2 * 3);  // pairs x runs x selections x methods
+  EXPECT_EQ(all, 2 * 2 * 3);
 }
 
 TEST(EvalTrajectoryCli, MissingBag) {

@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "datasets/point_subset.h"
 #include "datasets/readers.h"
 #include "datasets/sequence.h"
 #include "datasets/text_file.h"
@@ -863,6 +864,81 @@ TEST(SuperGlue, ReportsMissingFilesAndMalformedLines) {
   const std::string missing = (dir.path() / "missing.txt").string();
   EXPECT_FALSE(read_superglue(missing, "", &pairs, &error));
   EXPECT_TRUE(contains(error, missing + ": no such file"));
+}
+
+// ------------------------------------------------------------------------------------------------
+// The few-points regime of the pair evaluation (hybrid_vo_eval_pairs --max-points)
+
+std::vector<PointMatch> grid_matches(int n) {
+  std::vector<PointMatch> points(n);
+  for (int i = 0; i < n; ++i) {
+    points[i].x1 = Eigen::Vector2d(37.0 * (i % 17), 23.0 * (i / 17));
+    points[i].x2 = points[i].x1 + Eigen::Vector2d(1.0, 0.5);
+  }
+  return points;
+}
+
+TEST(PointSubset, KeepsExactlyNDistinctMatches) {
+  const std::vector<PointMatch> points = grid_matches(300);
+  for (const PointSelection selection : {PointSelection::kRandom, PointSelection::kClustered}) {
+    for (const int n : {1, 20, 40, 80, 299}) {
+      for (uint64_t seed = 0; seed < 5; ++seed) {
+        const std::vector<int> kept = select_point_matches(points, n, selection, seed);
+        ASSERT_EQ(static_cast<int>(kept.size()), n) << to_string(selection);
+        EXPECT_TRUE(std::is_sorted(kept.begin(), kept.end()));
+        EXPECT_EQ(std::adjacent_find(kept.begin(), kept.end()), kept.end()) << "duplicates";
+        EXPECT_GE(kept.front(), 0);
+        EXPECT_LT(kept.back(), 300);
+      }
+    }
+    // Asking for more than there are, or for all, keeps everything.
+    EXPECT_EQ(select_point_matches(points, 300, selection, 1).size(), 300u);
+    EXPECT_EQ(select_point_matches(points, 5000, selection, 1).size(), 300u);
+    EXPECT_EQ(select_point_matches(points, -1, selection, 1).size(), 300u);
+    EXPECT_TRUE(select_point_matches({}, 40, selection, 1).empty());
+  }
+}
+
+TEST(PointSubset, SeededNestedAndDifferentPerSeed) {
+  const std::vector<PointMatch> points = grid_matches(300);
+  for (const PointSelection selection : {PointSelection::kRandom, PointSelection::kClustered}) {
+    const std::vector<int> a = select_point_matches(points, 40, selection, 7);
+    EXPECT_EQ(a, select_point_matches(points, 40, selection, 7));
+    EXPECT_NE(a, select_point_matches(points, 40, selection, 8));
+    // A smaller N keeps a subset of a larger N's matches (same seed).
+    const std::vector<int> small = select_point_matches(points, 20, selection, 7);
+    EXPECT_TRUE(std::includes(a.begin(), a.end(), small.begin(), small.end()));
+  }
+}
+
+TEST(PointSubset, ClusteredKeepsOnePatchRandomSpreadsOut) {
+  const std::vector<PointMatch> points = grid_matches(289);  // 17 x 17, 37 x 23 px cells
+  auto spread = [&](const std::vector<int>& kept) {
+    Eigen::Vector2d lo = points[kept[0]].x1, hi = lo;
+    for (int i : kept) {
+      lo = lo.cwiseMin(points[i].x1);
+      hi = hi.cwiseMax(points[i].x1);
+    }
+    return (hi - lo).norm();
+  };
+  double clustered = 0.0, random = 0.0;
+  for (uint64_t seed = 0; seed < 20; ++seed) {
+    clustered += spread(select_point_matches(points, 20, PointSelection::kClustered, seed));
+    random += spread(select_point_matches(points, 20, PointSelection::kRandom, seed));
+  }
+  // 20 nearest neighbours of a grid point lie within about 2.5 cells of it.
+  EXPECT_LT(clustered / 20, 250.0);
+  EXPECT_GT(random / 20, 2.0 * clustered / 20);
+}
+
+TEST(PointSubset, ParsesSelectionNames) {
+  PointSelection s = PointSelection::kRandom;
+  EXPECT_TRUE(parse_point_selection("clustered", &s));
+  EXPECT_EQ(s, PointSelection::kClustered);
+  EXPECT_TRUE(parse_point_selection("random", &s));
+  EXPECT_EQ(s, PointSelection::kRandom);
+  EXPECT_FALSE(parse_point_selection("uniform", &s));
+  EXPECT_STREQ(to_string(PointSelection::kClustered), "clustered");
 }
 
 // ------------------------------------------------------------------------------------------------

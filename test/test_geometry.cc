@@ -169,6 +169,44 @@ TEST(Cheirality, ConflictingPointsRejectBothSigns) {
   EXPECT_FALSE(orient_translation(truth.R, &t, view));
 }
 
+// The ray form decides like the point form in any rotated copy of camera 2's frame, with the rays
+// at arbitrary positive scales; a point behind the cameras makes both reject every sign.
+TEST(Cheirality, RaysInARotatedFrameAgreeWithPoints) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n;
+  std::uniform_real_distribution<double> scale(0.1, 10.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const RelativePose truth(random_rotation(rng),
+                             Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized());
+    const Eigen::Matrix3d Q = random_rotation(rng);
+    Eigen::Vector2d x1[3], x2[3];
+    Eigen::Vector3d r[3], q[3];
+    const bool one_behind = trial % 4 == 0;
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d X(n(rng), n(rng), 6.0 + n(rng));
+      if (one_behind && k == 2) X = -X;
+      const Eigen::Vector3d X2 = truth.apply(X);
+      x1[k] = X.head<2>() / X.z();
+      x2[k] = X2.head<2>() / X2.z();
+      r[k] = scale(rng) * (Q * truth.R * homogeneous(x1[k]));
+      q[k] = scale(rng) * (Q * homogeneous(x2[k]));
+    }
+    MatchView view;
+    view.x1 = x1;
+    view.x2 = x2;
+    view.num_points = 3;
+    for (const double sign : {1.0, -1.0}) {
+      Eigen::Vector3d t_points = sign * truth.t, t_rays = sign * (Q * truth.t);
+      const bool ok_points = orient_translation(truth.R, &t_points, view);
+      const bool ok_rays = orient_translation_rays(r, q, 3, &t_rays);
+      ASSERT_EQ(ok_points, ok_rays) << "trial " << trial;
+      if (!ok_points) continue;
+      EXPECT_LT((Q * t_points - t_rays).norm(), 1e-12);
+      if (!one_behind) EXPECT_LT((t_points - truth.t).norm(), 1e-12);
+    }
+  }
+}
+
 TEST(Homography, DecompositionContainsTheTruth) {
   std::mt19937_64 rng(7);
   std::normal_distribution<double> n;

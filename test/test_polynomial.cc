@@ -77,6 +77,16 @@ TEST(RealRoots, DoubleRootReportedOnce) {
   EXPECT_NEAR(roots[1], 1.5, 1e-6);
 }
 
+// x^4 + x = x (x + 1) (x^2 - x + 1): dividing p by p' = 4 x^3 + 1 leaves 3x/4, a remainder two
+// degrees lower, so the fast three-term chain gives way to the general one.
+TEST(RealRoots, SturmChainWithADegreeDrop) {
+  const double c[5] = {0.0, 1.0, 0.0, 0.0, 1.0};
+  double roots[4];
+  ASSERT_EQ(real_roots(c, 4, roots), 2);
+  EXPECT_NEAR(roots[0], -1.0, 1e-14);
+  EXPECT_NEAR(roots[1], 0.0, 1e-14);
+}
+
 TEST(RealRoots, LeadingZerosLowerTheDegree) {
   const double c[5] = {-2.0, 1.0, 0.0, 0.0, 0.0};  // x - 2
   double roots[4];

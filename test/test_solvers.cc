@@ -9,6 +9,7 @@
 #include "hybrid_vo/estimation/refine_relative_pose.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
+#include "hybrid_vo/solvers/relpose_homography.h"
 #include "hybrid_vo/synthetic/minimal_instances.h"
 #include "solver_test_utils.h"
 
@@ -146,6 +147,168 @@ INSTANTIATE_TEST_SUITE_P(WellPosed, MinimalSolverTest,
                          ::testing::ValuesIn(testing::well_posed_solvers()), testing::solver_name);
 INSTANTIATE_TEST_SUITE_P(WithVanishingPoints, VpSolverTest,
                          ::testing::ValuesIn(testing::vp_solvers()), testing::solver_name);
+
+// The homography "DLT" maps the projective frame instead of eliminating (relpose_homography.h).
+// Distance between two homographies up to scale and sign.
+double homography_distance(const Eigen::Matrix3d& A, const Eigen::Matrix3d& B) {
+  const Eigen::Matrix3d a = A / A.norm(), b = B / B.norm();
+  return std::min((a - b).norm(), (a + b).norm());
+}
+
+Eigen::Matrix3d random_homography(std::mt19937_64& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Matrix3d H;
+  do {
+    for (int i = 0; i < 9; ++i) H(i) = n(rng);
+    H += 2.0 * Eigen::Matrix3d::Identity();
+  } while (std::abs(H.determinant()) < 0.1 * std::pow(H.norm(), 3) / 27.0);
+  return H;
+}
+
+Eigen::Vector2d apply_homography(const Eigen::Matrix3d& H, const Eigen::Vector2d& x) {
+  return (H * homogeneous(x)).hnormalized();
+}
+
+TEST(HomographyFromCorrespondences, RandomProjectiveMapsAreExact) {
+  std::mt19937_64 rng(800);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> scale(0.2, 5.0);
+  auto random_vector = [&] { return Eigen::Vector3d(n(rng), n(rng), n(rng)); };
+  int exact4 = 0, exact_dual = 0;
+  const int trials = 1000;
+  for (int trial = 0; trial < trials; ++trial) {
+    const Eigen::Matrix3d G = random_homography(rng);
+    // Any scale and sign on either side.
+    Eigen::Vector3d a[4], b[4];
+    for (int i = 0; i < 4; ++i) {
+      a[i] = random_vector();
+      b[i] = (i % 2 ? -scale(rng) : scale(rng)) * (G * a[i]);
+    }
+    Eigen::Matrix3d estimate;
+    ASSERT_TRUE(homography_from_4_correspondences(a, b, &estimate));
+    EXPECT_NEAR(estimate.norm(), 1.0, 1e-12);
+    if (homography_distance(estimate, G) < 1e-10) ++exact4;
+    // Three of the kind and one dual: G^T g ~ f.
+    const Eigen::Vector3d f = random_vector();
+    const Eigen::Vector3d g = -scale(rng) * (G.transpose().inverse() * f);
+    ASSERT_TRUE(homography_from_3_correspondences_and_dual(a, b, f, g, &estimate));
+    if (homography_distance(estimate, G) < 1e-10) ++exact_dual;
+  }
+  // Random frames are sometimes nearly collinear, where any method loses digits.
+  EXPECT_GE(exact4, 0.995 * trials);
+  EXPECT_GE(exact_dual, 0.995 * trials);
+}
+
+TEST(HomographyFromCorrespondences, CollinearTriplesAndIncidencesAreRejected) {
+  std::mt19937_64 rng(801);
+  const Eigen::Matrix3d G = random_homography(rng);
+  Eigen::Vector3d a[4] = {{0.1, 0.2, 1.0}, {-0.3, 0.1, 1.0}, {0.2, -0.4, 1.0}, {0.5, 0.4, 1.0}};
+  Eigen::Vector3d b[4];
+  for (int i = 0; i < 4; ++i) b[i] = G * a[i];
+  Eigen::Matrix3d H;
+  ASSERT_TRUE(homography_from_4_correspondences(a, b, &H));
+  // Every triple, in either image.
+  for (int skip = 0; skip < 4; ++skip) {
+    for (int side = 0; side < 2; ++side) {
+      Eigen::Vector3d c[4] = {a[0], a[1], a[2], a[3]}, d[4] = {b[0], b[1], b[2], b[3]};
+      Eigen::Vector3d* v = side == 0 ? c : d;
+      const int i = (skip + 1) % 4, j = (skip + 2) % 4, k = (skip + 3) % 4;
+      v[k] = 0.3 * v[i] + 0.7 * v[j];
+      EXPECT_FALSE(homography_from_4_correspondences(c, d, &H)) << skip << " " << side;
+    }
+  }
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  Eigen::Vector3d with_zero[4] = {a[0], zero, a[2], a[3]};
+  EXPECT_FALSE(homography_from_4_correspondences(with_zero, b, &H));
+  Eigen::Vector3d with_nan[4] = {a[0], a[1], a[2], Eigen::Vector3d(NAN, 0.0, 1.0)};
+  EXPECT_FALSE(homography_from_4_correspondences(with_nan, b, &H));
+  // Dual: an a_i on f or a b_i on g.
+  const Eigen::Vector3d f = a[0].cross(a[3]), g = G.transpose().inverse() * f;
+  EXPECT_FALSE(homography_from_3_correspondences_and_dual(a, b, f, g, &H));
+  const Eigen::Vector3d f2(0.3, -0.2, 1.0), g2 = G.transpose().inverse() * f2;
+  ASSERT_TRUE(homography_from_3_correspondences_and_dual(a, b, f2, g2, &H));
+  EXPECT_LT(homography_distance(H, G), 1e-12);
+  EXPECT_FALSE(homography_from_3_correspondences_and_dual(a, b, f2, zero, &H));
+  Eigen::Vector3d collinear[3] = {a[0], a[1], 2.0 * a[0] - a[1]};
+  EXPECT_FALSE(homography_from_3_correspondences_and_dual(collinear, b, f2, g2, &H));
+}
+
+// Every mix of points and segments (the segments' endpoints need not correspond).
+TEST(HomographyFromPointsAndLines, EveryMixRecoversARandomHomography) {
+  std::mt19937_64 rng(802);
+  std::uniform_real_distribution<double> u(-0.6, 0.6), along(-0.5, 1.5);
+  for (const int num_points : {4, 3, 1, 0}) {
+    const int num_lines = 4 - num_points;
+    int exact = 0;
+    const int trials = 1000;
+    for (int trial = 0; trial < trials; ++trial) {
+      const Eigen::Matrix3d H = random_homography(rng);
+      Eigen::Vector2d x1[4], x2[4];
+      LineSegment s1[4], s2[4];
+      for (int i = 0; i < num_points; ++i) {
+        x1[i] = Eigen::Vector2d(u(rng), u(rng));
+        x2[i] = apply_homography(H, x1[i]);
+      }
+      for (int i = 0; i < num_lines; ++i) {
+        const Eigen::Vector2d p(u(rng), u(rng)), q(u(rng), u(rng));
+        s1[i] = LineSegment(p, q);
+        // Other points of the same line in image 2.
+        const double t1 = along(rng), t2 = along(rng);
+        s2[i] = LineSegment(apply_homography(H, p + t1 * (q - p)), apply_homography(H, p + t2 * (q - p)));
+      }
+      Eigen::Matrix3d estimate;
+      if (!homography_from_points_and_lines(x1, x2, num_points, s1, s2, num_lines, &estimate))
+        continue;
+      EXPECT_TRUE(all_finite(estimate));
+      if (homography_distance(estimate, H) < 1e-10) ++exact;
+    }
+    EXPECT_GE(exact, 0.995 * trials) << num_points << " points";
+  }
+}
+
+TEST(HomographyFromPointsAndLines, DegenerateMixesAreRejected) {
+  std::mt19937_64 rng(803);
+  const Eigen::Matrix3d H = random_homography(rng);
+  const Eigen::Vector2d x1[4] = {{0.1, 0.2}, {-0.3, 0.1}, {0.2, -0.4}, {0.5, 0.4}};
+  Eigen::Vector2d x2[4];
+  for (int i = 0; i < 4; ++i) x2[i] = apply_homography(H, x1[i]);
+  const LineSegment s1[4] = {{{-0.5, 0.3}, {0.4, 0.5}}, {{-0.2, -0.5}, {0.1, 0.6}},
+                             {{0.6, -0.1}, {0.3, 0.5}}, {{-0.6, -0.2}, {0.5, -0.3}}};
+  LineSegment s2[4];
+  for (int i = 0; i < 4; ++i)
+    s2[i] = LineSegment(apply_homography(H, s1[i].p1), apply_homography(H, s1[i].p2));
+  Eigen::Matrix3d estimate;
+  for (const int num_points : {4, 3, 1, 0}) {
+    ASSERT_TRUE(homography_from_points_and_lines(x1, x2, num_points, s1, s2, 4 - num_points,
+                                                 &estimate));
+    EXPECT_LT(homography_distance(estimate, H), 1e-12) << num_points << " points";
+  }
+  EXPECT_FALSE(homography_from_points_and_lines(x1, x2, 2, s1, s2, 2, &estimate));
+  EXPECT_FALSE(homography_from_points_and_lines(x1, x2, 4, s1, s2, 1, &estimate));
+  EXPECT_FALSE(homography_from_points_and_lines(x1, x2, -1, s1, s2, 5, &estimate));
+  // 3-1-0 with the line through one of the points; 1-3-0 with the point on one of the lines.
+  LineSegment through1(x1[1], x1[1] + Eigen::Vector2d(0.3, 0.1)),
+      through2(x2[1], apply_homography(H, x1[1] + Eigen::Vector2d(0.3, 0.1)));
+  EXPECT_FALSE(homography_from_points_and_lines(x1, x2, 3, &through1, &through2, 1, &estimate));
+  const Eigen::Vector2d on1 = 0.25 * s1[0].p1 + 0.75 * s1[0].p2;
+  const Eigen::Vector2d on2 = apply_homography(H, on1);
+  EXPECT_FALSE(homography_from_points_and_lines(&on1, &on2, 1, s1, s2, 3, &estimate));
+  // Zero-length segment, concurrent lines, collinear points.
+  LineSegment z1[4] = {s1[0], s1[1], s1[2], LineSegment(s1[3].p1, s1[3].p1)};
+  LineSegment z2[4] = {s2[0], s2[1], s2[2], LineSegment(s2[3].p1, s2[3].p1)};
+  EXPECT_FALSE(homography_from_points_and_lines(x1, x2, 0, z1, z2, 4, &estimate));
+  const Eigen::Vector2d centre1(0.05, -0.02), centre2 = apply_homography(H, centre1);
+  LineSegment c1[4], c2[4];
+  for (int i = 0; i < 4; ++i) {
+    c1[i] = i < 3 ? LineSegment(centre1, s1[i].p2) : s1[i];
+    c2[i] = i < 3 ? LineSegment(centre2, s2[i].p2) : s2[i];
+  }
+  EXPECT_FALSE(homography_from_points_and_lines(x1, x2, 0, c1, c2, 4, &estimate));
+  Eigen::Vector2d y1[4] = {x1[0], x1[1], 0.4 * x1[0] + 0.6 * x1[1], x1[3]}, y2[4];
+  for (int i = 0; i < 4; ++i) y2[i] = apply_homography(H, y1[i]);
+  EXPECT_FALSE(homography_from_points_and_lines(y1, y2, 4, s1, s2, 0, &estimate));
+  EXPECT_FALSE(homography_from_points_and_lines(y1, y2, 3, s1, s2, 1, &estimate));
+}
 
 TEST(SolverTable, ThirteenConfigurationsInPaperOrder) {
   const auto& table = solver_table();

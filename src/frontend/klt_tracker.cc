@@ -57,22 +57,31 @@ std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int6
   }
 
   // Re-detection by buckets keeps features spread over the image (a cluster of tracks on one
-  // textured object makes a poorly conditioned relative pose).
-  const int cells = std::max(1, options_.grid_cols * options_.grid_rows);
-  const int quota = std::max(1, options_.max_features / cells);
-  const int cell_w = (gray.cols + options_.grid_cols - 1) / std::max(1, options_.grid_cols);
-  const int cell_h = (gray.rows + options_.grid_rows - 1) / std::max(1, options_.grid_rows);
+  // textured object makes a poorly conditioned relative pose). With fewer features than cells
+  // the grid gets coarser, so that every cell has a quota of at least one and max_features stays
+  // a cap: the features, and so the matches that reach the estimator, never exceed it.
+  const int max_features = std::max(1, options_.max_features);
+  int cols = std::max(1, options_.grid_cols), rows = std::max(1, options_.grid_rows);
+  while (cols * rows > max_features && (cols > 1 || rows > 1)) {
+    if (cols >= rows) --cols;
+    else --rows;
+  }
+  const int cells = cols * rows;
+  const int quota = std::max(1, max_features / cells);
+  const int cell_w = (gray.cols + cols - 1) / cols;
+  const int cell_h = (gray.rows + rows - 1) / rows;
   std::vector<int> count(cells, 0);
   cv::Mat mask(gray.size(), CV_8U, cv::Scalar(255));
   for (const cv::Point2f& p : points_) {
-    const int cx = std::min(options_.grid_cols - 1, static_cast<int>(p.x) / cell_w);
-    const int cy = std::min(options_.grid_rows - 1, static_cast<int>(p.y) / cell_h);
-    ++count[cy * options_.grid_cols + cx];
+    const int cx = std::min(cols - 1, static_cast<int>(p.x) / cell_w);
+    const int cy = std::min(rows - 1, static_cast<int>(p.y) / cell_h);
+    ++count[cy * cols + cx];
     cv::circle(mask, p, static_cast<int>(options_.min_distance_px), cv::Scalar(0), cv::FILLED);
   }
-  for (int cy = 0; cy < options_.grid_rows; ++cy) {
-    for (int cx = 0; cx < options_.grid_cols; ++cx) {
-      const int missing = quota - count[cy * options_.grid_cols + cx];
+  for (int cy = 0; cy < rows; ++cy) {
+    for (int cx = 0; cx < cols; ++cx) {
+      const int room = max_features - static_cast<int>(points_.size());
+      const int missing = std::min(room, quota - count[cy * cols + cx]);
       if (missing <= 0) continue;
       const cv::Rect cell = cv::Rect(cx * cell_w, cy * cell_h, cell_w, cell_h) &
                             cv::Rect(0, 0, gray.cols, gray.rows);
@@ -85,6 +94,22 @@ std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int6
         ids_.push_back(next_id_++);
       }
     }
+  }
+  // Tracks crowding into a few cells can still exceed the cap: keep the oldest (lowest ids).
+  if (static_cast<int>(points_.size()) > max_features) {
+    std::vector<size_t> order(points_.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return ids_[a] < ids_[b]; });
+    order.resize(max_features);
+    std::sort(order.begin(), order.end());
+    std::vector<cv::Point2f> kept;
+    std::vector<int64_t> kept_ids;
+    for (size_t i : order) {
+      kept.push_back(points_[i]);
+      kept_ids.push_back(ids_[i]);
+    }
+    points_ = std::move(kept);
+    ids_ = std::move(kept_ids);
   }
   previous_ = gray.clone();
   return matches;

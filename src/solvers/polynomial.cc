@@ -73,6 +73,74 @@ class SturmChain {
   int length_;
 };
 
+// The generic Sturm chain of a monic p of degree n, where every remainder has degree one less
+// than its divisor, as the three-term recurrence p_{k-1} = (a_k + b_k x) p_k - c_k p_{k+1}
+// (c_k > 0) from p_n (a constant) and p_{n-1} (linear). Evaluating the whole chain at x then
+// costs O(n) instead of one Horner pass per member, O(n^2); bisection evaluates it many times.
+// Degree drops (a common factor of p and p', or a remainder that vanishes to rounding) are
+// left to SturmChain.
+class ThreeTermSturmChain {
+ public:
+  // False when the chain is not generic; the object is then unusable.
+  bool build(const double* monic, int degree) {
+    n_ = degree;
+    double prev[kMax + 1], cur[kMax + 1], next[kMax + 1];
+    std::copy(monic, monic + degree + 1, prev);
+    for (int i = 1; i <= degree; ++i) cur[i - 1] = i * monic[i] / degree;
+    // prev has degree m + 1 and cur degree m, with leading coefficients +-1.
+    for (int m = degree - 1; m >= 1; --m) {
+      const double b = prev[m + 1] / cur[m];
+      const double a = (prev[m] - b * cur[m - 1]) / cur[m];
+      next[0] = prev[0] - a * cur[0];
+      for (int j = 1; j < m; ++j) next[j] = prev[j] - b * cur[j - 1] - a * cur[j];
+      // next is the remainder, of degree m - 1 unless its top coefficient vanishes against the
+      // dividend (SturmChain's test).
+      double scale = 0.0;
+      for (int j = 0; j <= m + 1; ++j) scale = std::max(scale, std::abs(prev[j]));
+      const double lead = std::abs(next[m - 1]);
+      if (!(lead > 1e-13 * scale)) return false;
+      const int k = degree - m;  // divisor p_k, remainder gives p_{k+1}
+      a_[k] = a;
+      b_[k] = b;
+      c_[k] = lead;
+      const double inv = -1.0 / lead;
+      for (int j = 0; j < m; ++j) prev[j] = cur[j];
+      prev[m] = cur[m];
+      for (int j = 0; j < m; ++j) cur[j] = next[j] * inv;
+    }
+    // cur is now p_n, a nonzero constant (+-1); prev is p_{n-1}, linear.
+    last_ = cur[0];
+    linear0_ = prev[0];
+    linear1_ = prev[1];
+    return true;
+  }
+
+  int sign_changes(double x) const {
+    double f_next = last_;                      // p_n
+    double f = linear0_ + linear1_ * x;         // p_{n-1}
+    int changes = 0;
+    double previous = f_next;                   // nonzero
+    auto count = [&](double v) {
+      if (v == 0.0) return;
+      changes += (v > 0.0) != (previous > 0.0);
+      previous = v;
+    };
+    count(f);
+    for (int k = n_ - 1; k >= 1; --k) {
+      const double g = (a_[k] + b_[k] * x) * f - c_[k] * f_next;  // p_{k-1}
+      f_next = f;
+      f = g;
+      count(f);
+    }
+    return changes;
+  }
+
+ private:
+  double a_[kMax + 1], b_[kMax + 1], c_[kMax + 1];
+  double last_ = 1.0, linear0_ = 0.0, linear1_ = 1.0;
+  int n_ = 0;
+};
+
 // Value and derivative of a polynomial at x.
 void evaluate_with_derivative(const double* c, int degree, double x, double* f, double* df) {
   double v = c[degree], d = 0.0;
@@ -158,78 +226,11 @@ int quadratic_roots(double B, double C, double* roots) {
   return 2;
 }
 
-}  // namespace
-
-int real_roots_quartic(const double* c, double* roots) {
-  double scale = 0.0;
-  for (int i = 0; i <= 4; ++i) {
-    if (!std::isfinite(c[i])) return 0;
-    scale = std::max(scale, std::abs(c[i]));
-  }
-  if (!(std::abs(c[4]) > 1e-8 * scale)) return real_roots(c, 4, roots);
-  const double a = c[3] / c[4], b = c[2] / c[4], cc = c[1] / c[4], d = c[0] / c[4];
-  // x = y - a/4 gives y^4 + p y^2 + q y + r.
-  const double a2 = a * a;
-  const double p = b - 3.0 * a2 / 8.0;
-  const double q = cc - 0.5 * a * b + a2 * a / 8.0;
-  const double r = d - 0.25 * a * cc + a2 * b / 16.0 - 3.0 * a2 * a2 / 256.0;
-  // (y^2 + p/2 + m)^2 = 2m y^2 - q y + m^2 + m p + p^2/4 - r, a square when m solves the resolvent.
-  const double m = largest_cubic_root(p, 0.25 * p * p - r, -q * q / 8.0);
-  double ys[4];
-  int n = 0;
-  if (m > 1e-14 * (std::abs(p) + std::sqrt(std::abs(r)) + 1e-300)) {
-    const double s = std::sqrt(2.0 * m);
-    const double k = 0.5 * q / s;
-    n += quadratic_roots(-s, 0.5 * p + m + k, ys + n);
-    n += quadratic_roots(s, 0.5 * p + m - k, ys + n);
-  } else {
-    // q = 0: biquadratic in y^2.
-    double zs[2];
-    const int nz = quadratic_roots(p, r, zs);
-    for (int i = 0; i < nz; ++i) {
-      if (zs[i] < 0.0) continue;
-      ys[n++] = std::sqrt(zs[i]);
-      ys[n++] = -std::sqrt(zs[i]);
-    }
-  }
-  const double monic[5] = {d, cc, b, a, 1.0};
-  for (int i = 0; i < n; ++i) {
-    double x = ys[i] - 0.25 * a;
-    for (int iter = 0; iter < 3; ++iter) {
-      double f, df;
-      evaluate_with_derivative(monic, 4, x, &f, &df);
-      if (df == 0.0 || f == 0.0) break;
-      const double step = f / df;
-      x -= step;
-      if (std::abs(step) <= 1e-16 * std::abs(x)) break;
-    }
-    roots[i] = x;
-  }
-  std::sort(roots, roots + n);
-  return n;
-}
-
-double evaluate_polynomial(const double* c, int degree, double x) {
-  double v = c[degree];
-  for (int i = degree - 1; i >= 0; --i) v = v * x + c[i];
-  return v;
-}
-
-int real_roots(const double* c, int degree, double* roots) {
-  if (degree > kMax) return 0;
-  for (int i = 0; i <= degree; ++i)
-    if (!std::isfinite(c[i])) return 0;
-  while (degree > 0 && c[degree] == 0.0) --degree;
-  if (degree <= 0) return 0;
-  double monic[kMax + 1];
-  for (int i = 0; i <= degree; ++i) monic[i] = c[i] / c[degree];
-  if (degree == 1) {
-    roots[0] = -monic[0];
-    return 1;
-  }
-
-  const SturmChain chain(monic, degree);
-  const double bound = root_bound(monic, degree);
+// Isolates the distinct real roots of the monic polynomial in [-bound, bound] by bisection on
+// the Sturm counts of `chain`, then polishes each; ascending.
+template <typename Chain>
+int isolate_and_polish_roots(const Chain& chain, const double* monic, int degree, double bound,
+                             double* roots) {
   struct Interval {
     double lo, hi;
     int changes_lo, changes_hi;
@@ -271,6 +272,81 @@ int real_roots(const double* c, int degree, double* roots) {
   }
   std::sort(roots, roots + found);
   return found;
+}
+
+}  // namespace
+
+int real_roots_quartic(const double* c, double* roots) {
+  double scale = 0.0;
+  for (int i = 0; i <= 4; ++i) {
+    if (!std::isfinite(c[i])) return 0;
+    scale = std::max(scale, std::abs(c[i]));
+  }
+  if (!(std::abs(c[4]) > 1e-8 * scale)) return real_roots(c, 4, roots);
+  const double a = c[3] / c[4], b = c[2] / c[4], cc = c[1] / c[4], d = c[0] / c[4];
+  // x = y - a/4 gives y^4 + p y^2 + q y + r.
+  const double a2 = a * a;
+  const double p = b - 3.0 * a2 / 8.0;
+  const double q = cc - 0.5 * a * b + a2 * a / 8.0;
+  const double r = d - 0.25 * a * cc + a2 * b / 16.0 - 3.0 * a2 * a2 / 256.0;
+  // (y^2 + p/2 + m)^2 = 2m y^2 - q y + m^2 + m p + p^2/4 - r, a square when m solves the resolvent.
+  const double m = largest_cubic_root(p, 0.25 * p * p - r, -q * q / 8.0);
+  double ys[4];
+  int n = 0;
+  if (m > 1e-14 * (std::abs(p) + std::sqrt(std::abs(r)) + 1e-300)) {
+    const double s = std::sqrt(2.0 * m);
+    const double k = 0.5 * q / s;
+    n += quadratic_roots(-s, 0.5 * p + m + k, ys + n);
+    n += quadratic_roots(s, 0.5 * p + m - k, ys + n);
+  } else {
+    // q = 0: biquadratic in y^2.
+    double zs[2];
+    const int nz = quadratic_roots(p, r, zs);
+    for (int i = 0; i < nz; ++i) {
+      if (zs[i] < 0.0) continue;
+      ys[n++] = std::sqrt(zs[i]);
+      ys[n++] = -std::sqrt(zs[i]);
+    }
+  }
+  // Three Newton steps on every root side by side: no data-dependent exits, whose mispredicted
+  // branches cost more than the arithmetic, and independent roots overlap in the pipeline.
+  for (int i = 0; i < n; ++i) roots[i] = ys[i] - 0.25 * a;
+  for (int iter = 0; iter < 3; ++iter) {
+    for (int i = 0; i < n; ++i) {
+      const double x = roots[i];
+      const double f = (((x + a) * x + b) * x + cc) * x + d;
+      const double df = ((4.0 * x + 3.0 * a) * x + 2.0 * b) * x + cc;
+      roots[i] = df != 0.0 ? x - f / df : x;
+    }
+  }
+  std::sort(roots, roots + n);
+  return n;
+}
+
+double evaluate_polynomial(const double* c, int degree, double x) {
+  double v = c[degree];
+  for (int i = degree - 1; i >= 0; --i) v = v * x + c[i];
+  return v;
+}
+
+int real_roots(const double* c, int degree, double* roots) {
+  if (degree > kMax) return 0;
+  for (int i = 0; i <= degree; ++i)
+    if (!std::isfinite(c[i])) return 0;
+  while (degree > 0 && c[degree] == 0.0) --degree;
+  if (degree <= 0) return 0;
+  double monic[kMax + 1];
+  for (int i = 0; i <= degree; ++i) monic[i] = c[i] / c[degree];
+  if (degree == 1) {
+    roots[0] = -monic[0];
+    return 1;
+  }
+
+  const double bound = root_bound(monic, degree);
+  ThreeTermSturmChain generic;
+  if (generic.build(monic, degree))
+    return isolate_and_polish_roots(generic, monic, degree, bound, roots);
+  return isolate_and_polish_roots(SturmChain(monic, degree), monic, degree, bound, roots);
 }
 
 }  // namespace hybrid_vo

@@ -98,19 +98,25 @@ bool eliminate_leading_monomials(Eigen::Matrix<double, 10, 20> M, Eigen::Matrix<
 // polynomial loses digits when two of its roots are close; the original system does not.
 void refine_xyz(const Eigen::Matrix<double, 10, 20>& C, double* x, double* y, double* z) {
   const double a = *x, b = *y, c = *z;
-  Eigen::Matrix<double, 20, 4> m;  // monomials and their x, y, z derivatives, in kCubic order
-  m.col(0) << a * a * a, b * b * b, a * a * b, a * b * b, a * a * c, a * a, b * b * c, b * b,
-      a * b * c, a * b, a * c * c, a * c, a, b * c * c, b * c, b, c * c * c, c * c, c, 1.0;
-  m.col(1) << 3 * a * a, 0, 2 * a * b, b * b, 2 * a * c, 2 * a, 0, 0, b * c, b, c * c, c, 1, 0, 0,
-      0, 0, 0, 0, 0;
-  m.col(2) << 0, 3 * b * b, a * a, 2 * a * b, 0, 0, 2 * b * c, 2 * b, a * c, a, 0, 0, 0, c * c, c,
-      1, 0, 0, 0, 0;
-  m.col(3) << 0, 0, 0, 0, a * a, 0, b * b, 0, a * b, 0, 2 * a * c, a, 0, 2 * b * c, b, 0,
-      3 * c * c, 2 * c, 1, 0;
-  const Eigen::Matrix<double, 10, 4> rJ = C.lazyProduct(m);  // no GEMM machinery at this size
-  const Eigen::Matrix<double, 10, 3> J = rJ.rightCols<3>();
+  const double aa = a * a, bb = b * b, cc = c * c, ab = a * b, ac = a * c, bc = b * c;
+  using Column = Eigen::Matrix<double, 10, 1>;
+  auto col = [&C](int k) { return C.col(k); };
+  // Residual C m and its x, y, z derivatives, one column of C at a time and only where the
+  // monomial's derivative is nonzero (kCubic order): a dense 10x20 by 20x4 product costs
+  // twice as much.
+  const double m[20] = {aa * a, bb * b, aa * b, a * bb, aa * c, aa, bb * c, bb, ab * c, ab,
+                        a * cc, ac,     a,      b * cc, bc,     b,  cc * c, cc, c,      1.0};
+  Column r = Column::Zero();
+  for (int k = 0; k < 20; ++k) r += m[k] * col(k);
+  Eigen::Matrix<double, 10, 3> J;
+  J.col(0) = 3 * aa * col(0) + 2 * ab * col(2) + bb * col(3) + 2 * ac * col(4) + 2 * a * col(5) +
+             bc * col(8) + b * col(9) + cc * col(10) + c * col(11) + col(12);
+  J.col(1) = 3 * bb * col(1) + aa * col(2) + 2 * ab * col(3) + 2 * bc * col(6) + 2 * b * col(7) +
+             ac * col(8) + a * col(9) + cc * col(13) + c * col(14) + col(15);
+  J.col(2) = aa * col(4) + bb * col(6) + ab * col(8) + 2 * ac * col(10) + a * col(11) +
+             2 * bc * col(13) + b * col(14) + 3 * cc * col(16) + 2 * c * col(17) + col(18);
   const Eigen::Matrix3d JtJ = J.transpose().lazyProduct(J);
-  const Eigen::Vector3d step = -(JtJ.inverse() * (J.transpose() * rJ.col(0)));
+  const Eigen::Vector3d step = -(JtJ.inverse() * (J.transpose().lazyProduct(r)));
   if (!all_finite(step)) return;
   *x += step(0);
   *y += step(1);

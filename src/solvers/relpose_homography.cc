@@ -6,50 +6,134 @@
 
 #include "hybrid_vo/geometry/cheirality.h"
 #include "hybrid_vo/geometry/homography.h"
-#include "hybrid_vo/solvers/null_vector.h"
 
 namespace hybrid_vo {
+
+namespace {
+
+// Relative size below which three of the entities count as collinear (concurrent), or a point as
+// lying on a line: the determinant (dot product) of the unit vectors, about the angle between them.
+constexpr double kDegenerate = 1e-10;
+
+// |det(u, v, w)| > kDegenerate |u| |v| |w| on squares (no roots); false for NaN too.
+bool independent(double det, double uu, double vv, double ww) {
+  return det * det > kDegenerate * kDegenerate * uu * vv * ww;
+}
+
+// G = B diag(d) A^-1 takes a_i to b_i (i < 3) for every d; the fourth correspondence fixes d.
+// adj(A), whose rows are cross products, stands in for A^-1 (equal up to scale).
+Eigen::Matrix3d frame_map(const Eigen::Matrix3d& adj_a, const Eigen::Vector3d* b,
+                          const Eigen::Vector3d& d) {
+  Eigen::Matrix3d B;
+  B << b[0] * d(0), b[1] * d(1), b[2] * d(2);
+  return B * adj_a;
+}
+
+Eigen::Matrix3d adjugate_of_columns(const Eigen::Vector3d* a) {
+  Eigen::Matrix3d adj;
+  adj.row(0) = a[1].cross(a[2]);
+  adj.row(1) = a[2].cross(a[0]);
+  adj.row(2) = a[0].cross(a[1]);
+  return adj;
+}
+
+// Scales G to unit Frobenius norm; false when it is zero or not finite.
+bool normalise(Eigen::Matrix3d* G) {
+  const double norm = G->norm();
+  if (!(norm > 0.0) || !std::isfinite(norm)) return false;
+  *G *= 1.0 / norm;
+  return true;
+}
+
+// The two results without the final normalisation (see the header).
+bool map_of_4(const Eigen::Vector3d* a, const Eigen::Vector3d* b, Eigen::Matrix3d* G) {
+  // lambda = A^-1 a3 scales the frame so that e1 + e2 + e3 goes to a3; then d_i = mu_i / lambda_i
+  // ~ mu_i lambda_j lambda_k. The four determinants vanish when one triple is collinear.
+  const Eigen::Matrix3d adj_a = adjugate_of_columns(a), adj_b = adjugate_of_columns(b);
+  const Eigen::Vector3d lambda = adj_a * a[3], mu = adj_b * b[3];
+  const double det_a = adj_a.row(0).dot(a[0]), det_b = adj_b.row(0).dot(b[0]);
+  double na[4], nb[4];
+  for (int i = 0; i < 4; ++i) na[i] = a[i].squaredNorm(), nb[i] = b[i].squaredNorm();
+  if (!independent(det_a, na[0], na[1], na[2]) || !independent(det_b, nb[0], nb[1], nb[2]) ||
+      !independent(lambda(0), na[1], na[2], na[3]) || !independent(mu(0), nb[1], nb[2], nb[3]) ||
+      !independent(lambda(1), na[2], na[0], na[3]) || !independent(mu(1), nb[2], nb[0], nb[3]) ||
+      !independent(lambda(2), na[0], na[1], na[3]) || !independent(mu(2), nb[0], nb[1], nb[3]))
+    return false;
+  *G = frame_map(adj_a, b, Eigen::Vector3d(mu(0) * lambda(1) * lambda(2),
+                                           mu(1) * lambda(2) * lambda(0),
+                                           mu(2) * lambda(0) * lambda(1)));
+  return true;
+}
+
+bool map_of_3_and_dual(const Eigen::Vector3d* a, const Eigen::Vector3d* b, const Eigen::Vector3d& f,
+                       const Eigen::Vector3d& g, Eigen::Matrix3d* G) {
+  // G^T g = A^-T diag(d) B^T g ~ f gives d_i (b_i . g) ~ a_i . f, so d_i ~ u_i w_j w_k.
+  const Eigen::Matrix3d adj_a = adjugate_of_columns(a);
+  const double det_a = adj_a.row(0).dot(a[0]), det_b = b[0].dot(b[1].cross(b[2]));
+  const Eigen::Vector3d u(a[0].dot(f), a[1].dot(f), a[2].dot(f));
+  const Eigen::Vector3d w(b[0].dot(g), b[1].dot(g), b[2].dot(g));
+  double na[3], nb[3];
+  for (int i = 0; i < 3; ++i) na[i] = a[i].squaredNorm(), nb[i] = b[i].squaredNorm();
+  const double nf = f.squaredNorm(), ng = g.squaredNorm();
+  if (!independent(det_a, na[0], na[1], na[2]) || !independent(det_b, nb[0], nb[1], nb[2]))
+    return false;
+  for (int i = 0; i < 3; ++i)
+    if (!independent(u(i), na[i], nf, 1.0) || !independent(w(i), nb[i], ng, 1.0)) return false;
+  *G = frame_map(adj_a, b, Eigen::Vector3d(u(0) * w(1) * w(2), u(1) * w(2) * w(0),
+                                           u(2) * w(0) * w(1)));
+  return true;
+}
+
+}  // namespace
+
+bool homography_from_4_correspondences(const Eigen::Vector3d* a, const Eigen::Vector3d* b,
+                                       Eigen::Matrix3d* G) {
+  return map_of_4(a, b, G) && normalise(G);
+}
+
+bool homography_from_3_correspondences_and_dual(const Eigen::Vector3d* a, const Eigen::Vector3d* b,
+                                                const Eigen::Vector3d& f, const Eigen::Vector3d& g,
+                                                Eigen::Matrix3d* G) {
+  return map_of_3_and_dual(a, b, f, g, G) && normalise(G);
+}
 
 bool homography_from_points_and_lines(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2,
                                       int num_points, const LineSegment* s1, const LineSegment* s2,
                                       int num_lines, Eigen::Matrix3d* H) {
   if (num_points < 0 || num_lines < 0 || num_points + num_lines != 4) return false;
-  // Constraints as rows of A, h = row-major H.
-  Eigen::Matrix<double, 8, 9> A = Eigen::Matrix<double, 8, 9>::Zero();
-  int col = 0;
-  for (int i = 0; i < num_points; ++i) {
-    // x2 x (H x1) = 0; its first two components are independent since x2 = (u, v, 1).
-    const Eigen::Vector3d p = homogeneous(x1[i]);
-    const double u = x2[i].x(), v = x2[i].y();
-    A.block<1, 3>(col, 3) = -p.transpose();
-    A.block<1, 3>(col, 6) = v * p.transpose();
-    A.block<1, 3>(col + 1, 0) = p.transpose();
-    A.block<1, 3>(col + 1, 6) = -u * p.transpose();
-    col += 2;
-  }
+  // Two points and two lines never fix H (README, "2-2-0 is degenerate").
+  if (num_points == 2) return false;
+  // Centred coordinates (as HZ2004 Sec. 4.4.4 normalises the DLT): the cross products then do
+  // not cancel digits against the homogeneous 1.
+  Eigen::Vector2d c1 = Eigen::Vector2d::Zero(), c2 = Eigen::Vector2d::Zero();
+  for (int i = 0; i < num_points; ++i) c1 += x1[i], c2 += x2[i];
+  for (int i = 0; i < num_lines; ++i) c1 += s1[i].p1 + s1[i].p2, c2 += s2[i].p1 + s2[i].p2;
+  const double inv_count = 1.0 / (num_points + 2 * num_lines);
+  c1 *= inv_count;
+  c2 *= inv_count;
+  // Points map as x2 ~ H x1, lines as l1 ~ H^T l2.
+  Eigen::Vector3d p1[4], p2[4], l1[4], l2[4];
+  for (int i = 0; i < num_points; ++i) p1[i] = homogeneous(x1[i] - c1), p2[i] = homogeneous(x2[i] - c2);
   for (int i = 0; i < num_lines; ++i) {
-    // l1 x (H^T l2) = 0; drop the component that does not involve l1's largest coordinate.
-    Eigen::Vector3d l1 = s1[i].line(), l2 = s2[i].line();
-    const double n1 = l1.norm(), n2 = l2.norm();
-    if (!(n1 > 0.0 && n2 > 0.0)) return false;
-    l1 /= n1;
-    l2 /= n2;
-    int skip;
-    l1.cwiseAbs().maxCoeff(&skip);
-    for (int eq = 0; eq < 3; ++eq) {
-      if (eq == skip) continue;
-      // (l1 x m)_eq = l1[a] m[b] - l1[b] m[a] with m_c = sum_r l2[r] H(r, c).
-      const int a = (eq + 1) % 3, b = (eq + 2) % 3;
-      for (int r = 0; r < 3; ++r) {
-        A(col, 3 * r + b) += l1(a) * l2(r);
-        A(col, 3 * r + a) -= l1(b) * l2(r);
-      }
-      ++col;
-    }
+    l1[i] = homogeneous(s1[i].p1 - c1).cross(homogeneous(s1[i].p2 - c1));
+    l2[i] = homogeneous(s2[i].p1 - c2).cross(homogeneous(s2[i].p2 - c2));
   }
-  Eigen::Matrix<double, 9, 1> h;
-  if (!null_vector<8>(A, &h)) return false;  // also rejects non-finite input
-  *H << h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), h(8);
+  Eigen::Matrix3d Hc;
+  bool ok;
+  switch (num_points) {
+    case 4: ok = map_of_4(p1, p2, &Hc); break;
+    case 3: ok = map_of_3_and_dual(p1, p2, l1[0], l2[0], &Hc); break;  // H^T l2 ~ l1
+    case 1: ok = map_of_3_and_dual(l2, l1, p2[0], p1[0], &Hc); break;  // H^T: l2 -> l1, H x1 ~ x2
+    default: ok = map_of_4(l2, l1, &Hc); break;                         // H^T: l2 -> l1
+  }
+  if (!ok) return false;
+  if (num_points < 3) Hc.transposeInPlace();
+  // Undo the centring: H = T(c2)^-1 Hc T(c1) with T(c) x = x - c.
+  Hc.col(2) -= Hc.col(0) * c1.x() + Hc.col(1) * c1.y();
+  Hc.row(0) += c2.x() * Hc.row(2);
+  Hc.row(1) += c2.y() * Hc.row(2);
+  if (!normalise(&Hc)) return false;
+  *H = Hc;
   return true;
 }
 

@@ -37,13 +37,16 @@ struct Arguments {
   uint64_t seed = 42;
   std::string histograms_dir;
   std::string noise_dir;
+  std::string only;  // one configuration code, e.g. 5-0-0; empty for all
 };
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
-            << " [--instances N] [--seed S] [--histograms DIR] [--noise-curve DIR]\n"
+            << " [--instances N] [--seed S] [--only CONFIG] [--histograms DIR] [--noise-curve DIR]\n"
                "  Prints one CSV row per minimal configuration (paper Fig. 2), then OpenGV's\n"
                "  five-point solvers on the same 5-0-0 instances, and their speed ratio.\n"
+               "  --only CONFIG      one configuration, e.g. 5-0-0 or 3-0-1 (peers run with 5-0-0);\n"
+               "                     for profiling one solver under callgrind\n"
                "  --histograms DIR   log10 error histograms (CSV + PNG), as the paper's Fig. 3\n"
                "  --noise-curve DIR  median errors against pixel noise, raw and after local\n"
                "                     optimisation on 50 points (CSV + PNG), as its Figs. 4-5\n";
@@ -76,6 +79,10 @@ bool parse(int argc, char** argv, Arguments* args) {
       const char* v = value("--seed");
       if (!v) return false;
       args->seed = std::strtoull(v, nullptr, 10);
+    } else if (a == "--only") {
+      const char* v = value("--only");
+      if (!v) return false;
+      args->only = v;
     } else if (a == "--histograms") {
       const char* v = value("--histograms");
       if (!v) return false;
@@ -101,6 +108,7 @@ struct Row {
   int instances = 0;
   std::vector<double> log_rot, log_trans;
   double fail_rate = 0.0, us_per_call = 0.0, mean_solutions = 0.0;
+  bool signs_known = false;  // the extra 3-0-1 row; left out of the histograms
 };
 
 // Median over chunks of the mean time per call: robust to a noisy machine.
@@ -225,6 +233,7 @@ bool write_histograms(const std::string& dir, const std::vector<Row>& rows) {
   csv << "config,solver,error,bin_lo,bin_hi,count\n";
   std::vector<tools::PlotSeries> rot_series, trans_series;
   for (const Row& r : rows) {
+    if (r.signs_known) continue;
     for (int kind = 0; kind < 2; ++kind) {
       const std::vector<double>& values = kind == 0 ? r.log_rot : r.log_trans;
       std::vector<int> counts(bins, 0);
@@ -336,22 +345,48 @@ int main(int argc, char** argv) {
               "us_per_call,mean_solutions\n");
   std::vector<Row> rows;
   std::vector<MinimalInstance> five_point_data;
+  if (!args.only.empty()) {
+    SolverId id;
+    if (!find_solver(args.only, &id)) {
+      std::cerr << "error: unknown configuration '" << args.only << "'\n";
+      return 2;
+    }
+  }
+  double five_point_us = 0.0;
   for (const SolverInfo& info : solver_table()) {
-    std::mt19937_64 rng(args.seed + static_cast<int>(info.id));
-    std::vector<MinimalInstance> data;
-    data.reserve(args.instances);
-    for (int i = 0; i < args.instances; ++i) data.push_back(generate_minimal_instance(info.id, rng));
-    rows.push_back(bench_solver(info, data));
-    print_row(rows.back());
-    if (info.id == SolverId::k5pt) five_point_data = std::move(data);
+    if (!args.only.empty() && args.only != info.code && args.only != ascii_code(info) &&
+        args.only != info.function)
+      continue;
+    // The VP solvers run with unknown VP signs (both signs tried), and 3-0-1 once more with the
+    // sign known, as a tracked VP gives it; that row compares with upright 3-point solvers.
+    for (const bool signs_known : {false, true}) {
+      if (signs_known && info.id != SolverId::k1vp3pt) continue;
+      std::mt19937_64 rng(args.seed + static_cast<int>(info.id));
+      MinimalInstanceOptions options;
+      options.orient_vps = signs_known;
+      std::vector<MinimalInstance> data;
+      data.reserve(args.instances);
+      for (int i = 0; i < args.instances; ++i)
+        data.push_back(generate_minimal_instance(info.id, rng, options));
+      rows.push_back(bench_solver(info, data));
+      if (signs_known) {
+        rows.back().solver += " (VP sign known)";
+        rows.back().signs_known = true;
+      }
+      print_row(rows.back());
+      if (info.id == SolverId::k5pt) five_point_data = std::move(data);
+    }
+    if (info.id == SolverId::k5pt) five_point_us = rows.back().us_per_call;
   }
 #ifdef HYBRID_VO_HAVE_OPENGV
-  const std::vector<Row> peers = bench_opengv(five_point_data);
-  for (const Row& r : peers) print_row(r);
-  for (const Row& r : peers)
-    std::printf("# speed: %s takes %.2fx the time of relpose_5pt (median us per call, same "
-                "instances, same run)\n",
-                r.solver.c_str(), r.us_per_call / rows[0].us_per_call);
+  if (five_point_us > 0.0) {
+    const std::vector<Row> peers = bench_opengv(five_point_data);
+    for (const Row& r : peers) print_row(r);
+    for (const Row& r : peers)
+      std::printf("# speed: %s takes %.2fx the time of relpose_5pt (median us per call, same "
+                  "instances, same run)\n",
+                  r.solver.c_str(), r.us_per_call / five_point_us);
+  }
 #else
   std::printf("# OpenGV was not found at build time: no peer timings\n");
 #endif

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "datasets/point_subset.h"
 #include "datasets/readers.h"
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/geometry/pose_error.h"
@@ -40,7 +41,20 @@ struct Arguments {
   int runs = 1;                   // RANSAC repetitions per pair and method, pooled into one AUC
   int min_iterations = -1;        // overrides of the presets' RANSAC settings (-1: preset's own)
   double point_threshold = -1.0;  // also used for OpenCV (default 1 px)
+  // The few-points regime: every value of max_points (-1: all) with every selection.
+  std::vector<int> max_points;
+  std::vector<datasets::PointSelection> selections = {datasets::PointSelection::kRandom};
   FrontendOptions frontend;
+};
+
+// One way of thinning the point matches: the first N under a selection, or all of them.
+struct PointSubset {
+  int max_points = -1;
+  datasets::PointSelection selection = datasets::PointSelection::kRandom;
+  std::string label() const {
+    return max_points < 0 ? "all,all"
+                          : std::to_string(max_points) + "," + datasets::to_string(selection);
+  }
 };
 
 void usage(const char* program) {
@@ -49,13 +63,18 @@ void usage(const char* program) {
       << "         [--images DIR] [--gap K] [--resize S] [--presets a,b,...] [--csv FILE]\n"
       << "         [--vp-modes] [--max-pairs N] [--points sift|orb] [--lines lsd|fld] [--seed S]\n"
       << "         [--runs N] [--min-iterations N] [--point-threshold PX]\n"
+      << "         [--max-points N[,N...|all]] [--point-selection random|clustered[,...]]\n"
       << "  Pairs are frames i and i+K (superglue: the pairs file, images under --images).\n"
       << "  Prints method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms (AUC in %),\n"
       << "  one row per preset plus opencv_usac_magsac (findEssentialMat + recoverPose on the same\n"
       << "  points, seeded like the presets). --vp-modes adds the VP ablation: standard, joint,\n"
       << "  joint+refined.\n"
       << "  --runs N repeats every estimator N times per pair with different seeds and pools the\n"
-      << "  errors, so that one unlucky RANSAC run does not decide a small data set's AUC.\n";
+      << "  errors, so that one unlucky RANSAC run does not decide a small data set's AUC.\n"
+      << "  --max-points N keeps N point matches per pair and run (all line matches), chosen with\n"
+      << "  the run's seed: random (uniformly) or clustered (the N nearest to a random match, as\n"
+      << "  in a low-texture image). Every method sees the same subset. With --max-points the\n"
+      << "  table starts with max_points,selection columns, one block per value and selection.\n";
 }
 
 bool parse(int argc, char** argv, Arguments* a) {
@@ -115,6 +134,28 @@ bool parse(int argc, char** argv, Arguments* a) {
       a->point_threshold = std::strtod(v.c_str(), &end);
       if (*end || !(a->point_threshold > 0.0))
         return std::cerr << "error: --point-threshold must be > 0\n", false;
+    } else if (arg == "--max-points") {
+      a->max_points.clear();
+      for (const std::string& item : tools::split_list(v)) {
+        if (item == "all") {
+          a->max_points.push_back(-1);
+          continue;
+        }
+        const long n = std::strtol(item.c_str(), &end, 10);
+        if (*end || n < 1 || n > 1000000)
+          return std::cerr << "error: --max-points takes positive counts or 'all'\n", false;
+        a->max_points.push_back(static_cast<int>(n));
+      }
+      if (a->max_points.empty()) return std::cerr << "error: --max-points needs a value\n", false;
+    } else if (arg == "--point-selection") {
+      a->selections.clear();
+      for (const std::string& item : tools::split_list(v)) {
+        datasets::PointSelection selection;
+        if (!datasets::parse_point_selection(item, &selection))
+          return std::cerr << "error: --point-selection must be random or clustered\n", false;
+        a->selections.push_back(selection);
+      }
+      if (a->selections.empty()) return std::cerr << "error: --point-selection needs a value\n", false;
     } else if (arg == "--points") {
       if (v == "orb") a->frontend.points.type = PointFeatureType::kOrb;
       else if (v != "sift") return std::cerr << "error: --points must be sift or orb\n", false;
@@ -189,12 +230,13 @@ class FeatureCache {
 };
 
 // OpenCV's USAC_MAGSAC plus recoverPose (opencv_baseline.h) on the same points.
-double run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const PinholeCamera& c2,
-                  const RelativePose& truth, double threshold_px, uint64_t seed, double* ms) {
+bool run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const PinholeCamera& c2,
+                double threshold_px, uint64_t seed, double* ms, RelativePose* pose) {
   const auto start = std::chrono::steady_clock::now();
   const tools::OpenCvPose result = tools::opencv_usac_magsac(m.points, c1, c2, threshold_px, seed);
   *ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  return result.ok ? pose_error(result.pose, truth) * kDeg : kFailed;
+  if (result.ok) *pose = result.pose;
+  return result.ok;
 }
 
 void print_row(const std::string& method, const MethodStats& s, double frontend_ms) {
@@ -245,11 +287,23 @@ int main(int argc, char** argv) {
       return 1;
     }
     csv << "pair,image0,image1,method,rot_err_deg,trans_err_deg,pose_err_deg,points,lines,vps,"
-           "estimator_ms\n";
+           "estimator_ms,max_points,selection\n";
   }
 
   FeatureCache cache(args);
-  std::map<std::string, MethodStats> stats;
+  std::vector<PointSubset> subsets;
+  if (args.max_points.empty()) subsets.push_back(PointSubset());
+  for (const int n : args.max_points) {
+    if (n < 0) {
+      subsets.push_back(PointSubset());
+      continue;
+    }
+    for (const datasets::PointSelection selection : args.selections)
+      subsets.push_back({n, selection});
+  }
+  // Per subset (label) and method.
+  std::map<std::string, std::map<std::string, MethodStats>> stats;
+  std::map<std::string, int> short_pairs;  // pairs with fewer point matches than asked for
   std::vector<double> frontend_ms;
   // VP ablation: per mode, VP matches per pair, consistent matches, and the VP solvers alone.
   const std::vector<std::string> vp_modes = {"standard", "joint", "joint+refined"};
@@ -270,58 +324,71 @@ int main(int argc, char** argv) {
     const CameraModel c0 = datasets::scaled(pair.camera0, args.resize);
     const CameraModel c1 = datasets::scaled(pair.camera1, args.resize);
     double match_ms = 0.0;
-    const TwoViewMatches matches = match_features(*f0, *f1, c0, c1, args.frontend, &match_ms);
+    const TwoViewMatches all_matches = match_features(*f0, *f1, c0, c1, args.frontend, &match_ms);
     frontend_ms.push_back(ms0 + ms1 + match_ms);
     RelativePose truth = pair.pose;
     truth.t.normalize();
-    auto record = [&](const std::string& method, const RelativePose* pose, double ms, int vps) {
-      const double rot = pose ? rotation_error(pose->R, truth.R) * kDeg : kFailed;
-      const double trans = pose ? translation_error(pose->t, truth.t) * kDeg : kFailed;
-      stats[method].errors.push_back(std::max(rot, trans));
-      stats[method].estimator_ms.push_back(ms);
-      if (pose) {
-        double x = 0.0, y = 0.0;
-        translation_offset(pose->t, truth.t, &x, &y);
-        stats[method].offset_x.push_back(x);
-        stats[method].offset_y.push_back(y);
-      }
-      if (csv)
-        csv << p << ',' << pair.image_path0 << ',' << pair.image_path1 << ',' << method << ','
-            << rot << ',' << trans << ',' << std::max(rot, trans) << ',' << matches.points.size()
-            << ',' << matches.lines.size() << ',' << vps << ',' << ms << '\n';
-    };
 
-    for (int run = 0; run < args.runs; ++run) {
-      for (const std::string& preset : args.presets) {
-        TwoViewOptions options;
-        preset_options(preset, &options.estimator);
-        if (args.min_iterations > 0) options.estimator.ransac.min_iterations = args.min_iterations;
-        if (args.point_threshold > 0.0)
-          options.estimator.ransac.point_threshold_px = args.point_threshold;
-        options.estimator.ransac.seed = args.seed + p + 1000003ull * run;
-        const auto start = std::chrono::steady_clock::now();
-        const TwoViewEstimate result =
-            estimate_two_view(c0.pinhole, c1.pinhole, matches, options);
-        const double ms =
-            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                .count();
-        const bool ok = result.estimate.status == EstimationStatus::kOk;
-        record(preset, ok ? &result.estimate.pose : nullptr, ms,
-               static_cast<int>(result.vps.matches.size()));
+    for (const PointSubset& subset : subsets) {
+      const std::string label = subset.label();
+      if (subset.max_points > static_cast<int>(all_matches.points.size())) ++short_pairs[label];
+      for (int run = 0; run < args.runs; ++run) {
+        const uint64_t seed = args.seed + p + 1000003ull * run;
+        TwoViewMatches matches = all_matches;
+        if (subset.max_points >= 0) {
+          matches.points.clear();
+          for (const int i : datasets::select_point_matches(all_matches.points, subset.max_points,
+                                                            subset.selection, seed))
+            matches.points.push_back(all_matches.points[i]);
+        }
+        auto record = [&](const std::string& method, double rot, double trans, double ms,
+                          int vps, const RelativePose* pose) {
+          MethodStats& s = stats[label][method];
+          s.errors.push_back(std::max(rot, trans));
+          s.estimator_ms.push_back(ms);
+          if (pose) {
+            double x = 0.0, y = 0.0;
+            translation_offset(pose->t, truth.t, &x, &y);
+            s.offset_x.push_back(x);
+            s.offset_y.push_back(y);
+          }
+          if (csv)
+            csv << p << ',' << pair.image_path0 << ',' << pair.image_path1 << ',' << method << ','
+                << rot << ',' << trans << ',' << std::max(rot, trans) << ','
+                << matches.points.size() << ',' << matches.lines.size() << ',' << vps << ','
+                << ms << ',' << label << '\n';
+        };
+        for (const std::string& preset : args.presets) {
+          TwoViewOptions options;
+          preset_options(preset, &options.estimator);
+          if (args.min_iterations > 0) options.estimator.ransac.min_iterations = args.min_iterations;
+          if (args.point_threshold > 0.0)
+            options.estimator.ransac.point_threshold_px = args.point_threshold;
+          options.estimator.ransac.seed = seed;
+          const auto start = std::chrono::steady_clock::now();
+          const TwoViewEstimate result =
+              estimate_two_view(c0.pinhole, c1.pinhole, matches, options);
+          const double ms =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                  .count();
+          const bool ok = result.estimate.status == EstimationStatus::kOk;
+          const RelativePose* pose = ok ? &result.estimate.pose : nullptr;
+          record(preset, pose ? rotation_error(pose->R, truth.R) * kDeg : kFailed,
+                 pose ? translation_error(pose->t, truth.t) * kDeg : kFailed, ms,
+                 static_cast<int>(result.vps.matches.size()), pose);
+        }
+        if (args.opencv) {
+          double ms = 0.0;
+          RelativePose pose;
+          const bool ok = run_opencv(matches, c0.pinhole, c1.pinhole,
+                                     args.point_threshold > 0.0 ? args.point_threshold : 1.0, seed,
+                                     &ms, &pose);
+          record("opencv_usac_magsac", ok ? rotation_error(pose.R, truth.R) * kDeg : kFailed,
+                 ok ? translation_error(pose.t, truth.t) * kDeg : kFailed, ms, 0, nullptr);
+        }
       }
     }
-    for (int run = 0; args.opencv && run < args.runs; ++run) {
-      double ms = 0.0;
-      const double e = run_opencv(matches, c0.pinhole, c1.pinhole, truth,
-                                 args.point_threshold > 0.0 ? args.point_threshold : 1.0,
-                                 args.seed + p + 1000003ull * run, &ms);
-      stats["opencv_usac_magsac"].errors.push_back(e);
-      stats["opencv_usac_magsac"].estimator_ms.push_back(ms);
-      if (csv)
-        csv << p << ',' << pair.image_path0 << ',' << pair.image_path1 << ",opencv_usac_magsac,,,"
-            << e << ',' << matches.points.size() << ',' << matches.lines.size() << ",0," << ms
-            << '\n';
-    }
+    const TwoViewMatches& matches = all_matches;
 
     if (args.vp_modes) {
       for (const std::string& mode : vp_modes) {
@@ -356,13 +423,22 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms\n");
+  const bool subset_columns = !args.max_points.empty();
+  std::printf("%smethod,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms\n",
+              subset_columns ? "max_points,selection," : "");
   const double fe = median(frontend_ms);
-  for (const std::string& preset : args.presets) print_row(preset, stats[preset], fe);
-  if (args.opencv) print_row("opencv_usac_magsac", stats["opencv_usac_magsac"], fe);
+  std::vector<std::string> methods = args.presets;
+  if (args.opencv) methods.push_back("opencv_usac_magsac");
+  for (const PointSubset& subset : subsets) {
+    const std::string label = subset.label();
+    for (const std::string& method : methods)
+      print_row((subset_columns ? label + "," : "") + method, stats[label][method], fe);
+  }
   std::printf("# %zu pairs, gap %d, resize %.2f\n", pairs.size(), args.gap, args.resize);
+  for (const auto& [label, count] : short_pairs)
+    std::printf("# %s: %d pairs had fewer point matches and kept them all\n", label.c_str(), count);
   if (!args.presets.empty()) {
-    const MethodStats& s = stats[args.presets.front()];
+    const MethodStats& s = stats[subsets.back().label()][args.presets.front()];
     std::printf("# %s: median translation offset from the truth along image x / y: %.3f / %.3f deg\n",
                 args.presets.front().c_str(), median(s.offset_x), median(s.offset_y));
   }

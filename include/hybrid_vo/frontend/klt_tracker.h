@@ -10,7 +10,7 @@
 namespace hybrid_vo {
 
 struct KltTrackerOptions {
-  int max_features = 1000;
+  int max_features = 1000;  // a cap on the features tracked (and so on the matches per pair)
   int grid_cols = 8, grid_rows = 6;  // bucketing: re-detection fills empty cells first
   double min_distance_px = 10.0;     // between tracked features
   double quality_level = 0.01;       // of cv::goodFeaturesToTrack

@@ -23,6 +23,12 @@ struct MatchView {
 // whose plane contains the baseline) say nothing and are skipped.
 bool orient_translation(const Eigen::Matrix3d& R, Eigen::Vector3d* t, const MatchView& matches);
 
+// orient_translation for point matches given as rays in camera 2's frame: r[i] = R x1_i and
+// q[i] = x2_i, each up to a positive scale, in any rotated copy of that frame (t in the same copy).
+// Solvers that work in a canonical frame decide the sign there, before forming R.
+bool orient_translation_rays(const Eigen::Vector3d* r, const Eigen::Vector3d* q, int n,
+                             Eigen::Vector3d* t);
+
 // Same test with a majority vote instead of unanimity, for a model fitted to many noisy matches:
 // flips t when more matches lie in front with -t than with t. Returns the margin of votes for the
 // chosen sign (0: undecided, t kept).
