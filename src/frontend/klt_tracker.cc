@@ -1,6 +1,8 @@
 #include "hybrid_vo/frontend/klt_tracker.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -8,40 +10,164 @@
 #include "hybrid_vo/frontend/gray_image.h"
 
 namespace hybrid_vo {
+namespace {
+
+constexpr float kUnknown = std::numeric_limits<float>::quiet_NaN();
+
+bool known(const cv::Point2f& motion) { return std::isfinite(motion.x); }
+
+float median_of(std::vector<float>* v) {
+  std::nth_element(v->begin(), v->begin() + v->size() / 2, v->end());
+  return (*v)[v->size() / 2];
+}
+
+// Pyramidal Lucas-Kanade for the features `which` of `from` (in `from_pyramid`) into
+// `to_pyramid`. A short search (levels >= 0) starts at `to[i]` and spans `levels` levels above
+// full resolution; a long one (levels < 0) starts at the feature itself and spans all levels.
+// Writes `to` and `found` of those features.
+void search(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
+            const std::vector<cv::Point2f>& from, const std::vector<int>& which, int levels,
+            const KltTrackerOptions& options, std::vector<cv::Point2f>* to,
+            std::vector<char>* found) {
+  if (which.empty()) return;
+  std::vector<cv::Point2f> a, b;
+  a.reserve(which.size());
+  b.reserve(which.size());
+  for (int i : which) {
+    a.push_back(from[i]);
+    b.push_back((*to)[i]);
+  }
+  std::vector<uchar> status;
+  std::vector<float> error;
+  const cv::Size window(options.window_px, options.window_px);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
+                                  std::max(1, options.max_iterations), 0.01);
+  if (levels < 0) {
+    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, error, window,
+                             options.pyramid_levels, criteria);
+  } else {
+    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, error, window, levels,
+                             criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+  }
+  for (size_t k = 0; k < which.size(); ++k) {
+    (*to)[which[k]] = b[k];
+    (*found)[which[k]] = status[k] != 0;
+  }
+}
+
+}  // namespace
 
 KltTracker::KltTracker(const KltTrackerOptions& options) : options_(options) {}
 
 void KltTracker::reset() {
-  previous_.release();
+  previous_.clear();
+  size_ = cv::Size();
   points_.clear();
+  motion_.clear();
   ids_.clear();
 }
 
 int KltTracker::num_tracks() const { return static_cast<int>(points_.size()); }
 
+std::vector<char> KltTracker::predict(std::vector<cv::Point2f>* next) const {
+  const size_t n = points_.size();
+  next->assign(points_.begin(), points_.end());
+  std::vector<char> predicted(n, 0);
+  if (!options_.predict_motion) return predicted;
+  // New features move like the median track of their grid cell (of the image when it has none).
+  const int cols = std::max(1, options_.grid_cols), rows = std::max(1, options_.grid_rows);
+  const int cell_w = std::max(1, (size_.width + cols - 1) / cols);
+  const int cell_h = std::max(1, (size_.height + rows - 1) / rows);
+  const int image_cell = cols * rows;
+  auto cell_of = [&](const cv::Point2f& p) {
+    const int cx = std::min(cols - 1, std::max(0, static_cast<int>(p.x) / cell_w));
+    const int cy = std::min(rows - 1, std::max(0, static_cast<int>(p.y) / cell_h));
+    return cy * cols + cx;
+  };
+  std::vector<std::vector<float>> dx(image_cell + 1), dy(image_cell + 1);
+  for (size_t i = 0; i < n; ++i) {
+    if (!known(motion_[i])) continue;
+    for (const int c : {cell_of(points_[i]), image_cell}) {
+      dx[c].push_back(motion_[i].x);
+      dy[c].push_back(motion_[i].y);
+    }
+  }
+  if (dx[image_cell].empty()) return predicted;  // no motion seen yet
+  std::vector<cv::Point2f> cell_motion(image_cell + 1);
+  for (int c = image_cell; c >= 0; --c) {
+    cell_motion[c] = dx[c].empty() ? cell_motion[image_cell]
+                                   : cv::Point2f(median_of(&dx[c]), median_of(&dy[c]));
+  }
+  for (size_t i = 0; i < n; ++i) {
+    (*next)[i] += known(motion_[i]) ? motion_[i] : cell_motion[cell_of(points_[i])];
+    predicted[i] = 1;
+  }
+  return predicted;
+}
+
 std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int64_t>* ids) {
+  std::vector<PointMatch> matches = track_existing(image, ids);
+  detect_new();
+  return matches;
+}
+
+std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image,
+                                                   std::vector<int64_t>* ids) {
   std::vector<PointMatch> matches;
   if (ids) ids->clear();
   if (image.empty()) return matches;
   const cv::Mat gray = to_gray8(image);
-  if (!previous_.empty() && previous_.size() != gray.size()) reset();
+  if (!previous_.empty() && size_ != gray.size()) reset();
+  // Each frame's pyramid (with the derivatives LK needs) is built once: it serves the forward
+  // search into this frame, the backward search out of it, and the next frame's forward search.
+  std::vector<cv::Mat> pyramid;
+  const cv::Size window(options_.window_px, options_.window_px);
+  cv::buildOpticalFlowPyramid(gray, pyramid, window, options_.pyramid_levels, true);
 
   if (!previous_.empty() && !points_.empty()) {
-    std::vector<cv::Point2f> next, back;
-    std::vector<uchar> status, back_status;
-    std::vector<float> error;
-    const cv::Size window(options_.window_px, options_.window_px);
-    cv::calcOpticalFlowPyrLK(previous_, gray, points_, next, status, error, window,
-                             options_.pyramid_levels);
-    // Forward-backward consistency (Kalal et al. 2010) rejects drifting and occluded tracks.
-    cv::calcOpticalFlowPyrLK(gray, previous_, next, back, back_status, error, window,
-                             options_.pyramid_levels);
-    std::vector<cv::Point2f> kept;
+    const size_t n = points_.size();
+    std::vector<cv::Point2f> predicted_at;
+    const std::vector<char> predicted = predict(&predicted_at);
+    const int short_levels =
+        std::max(0, std::min(options_.predicted_pyramid_levels, options_.pyramid_levels));
+    // Forward: short searches from the predictions; what they lose, and what has no prediction,
+    // the long way.
+    std::vector<cv::Point2f> next = predicted_at;
+    std::vector<char> found(n, 0), long_way(n, 0);
+    std::vector<int> short_search, long_search;
+    for (size_t i = 0; i < n; ++i)
+      (predicted[i] ? short_search : long_search).push_back(static_cast<int>(i));
+    search(previous_, pyramid, points_, short_search, short_levels, options_, &next, &found);
+    for (int i : short_search)
+      if (!found[i]) long_search.push_back(i);
+    std::sort(long_search.begin(), long_search.end());
+    for (int i : long_search) long_way[i] = 1;
+    search(previous_, pyramid, points_, long_search, -1, options_, &next, &found);
+
+    // Forward-backward consistency (Kalal et al. 2010) rejects drifting and occluded tracks. The
+    // backward search mirrors the forward one: a feature found the short way is searched for
+    // back from its position minus the predicted motion, over the same levels.
+    std::vector<cv::Point2f> back(n);
+    std::vector<char> back_found(n, 0);
+    std::vector<int> back_short, back_long;
+    for (size_t i = 0; i < n; ++i) {
+      if (!found[i]) continue;
+      if (long_way[i]) {
+        back_long.push_back(static_cast<int>(i));
+      } else {
+        back_short.push_back(static_cast<int>(i));
+        back[i] = next[i] - (predicted_at[i] - points_[i]);
+      }
+    }
+    search(pyramid, previous_, next, back_short, short_levels, options_, &back, &back_found);
+    search(pyramid, previous_, next, back_long, -1, options_, &back, &back_found);
+
+    std::vector<cv::Point2f> kept, kept_motion;
     std::vector<int64_t> kept_ids;
     const cv::Rect2f bounds(0.0f, 0.0f, gray.cols - 1.0f, gray.rows - 1.0f);
     const double max_fb_sq = options_.max_forward_backward_px * options_.max_forward_backward_px;
-    for (size_t i = 0; i < points_.size(); ++i) {
-      if (!status[i] || !back_status[i] || !bounds.contains(next[i])) continue;
+    for (size_t i = 0; i < n; ++i) {
+      if (!found[i] || !back_found[i] || !bounds.contains(next[i])) continue;
       const cv::Point2f d = back[i] - points_[i];
       if (d.dot(d) > max_fb_sq) continue;
       PointMatch m;
@@ -50,12 +176,22 @@ std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int6
       matches.push_back(m);
       if (ids) ids->push_back(ids_[i]);
       kept.push_back(next[i]);
+      kept_motion.push_back(next[i] - points_[i]);
       kept_ids.push_back(ids_[i]);
     }
     points_ = std::move(kept);
+    motion_ = std::move(kept_motion);
     ids_ = std::move(kept_ids);
   }
+  size_ = gray.size();
+  previous_ = std::move(pyramid);
+  return matches;
+}
 
+void KltTracker::detect_new() {
+  if (previous_.empty()) return;
+  // Level 0 of the pyramid is the image (inside the border the pyramid adds).
+  const cv::Mat& gray = previous_[0];
   // Re-detection by buckets keeps features spread over the image (a cluster of tracks on one
   // textured object makes a poorly conditioned relative pose). With fewer features than cells
   // the grid gets coarser, so that every cell has a quota of at least one and max_features stays
@@ -91,6 +227,7 @@ std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int6
                               options_.min_distance_px, mask(cell));
       for (const cv::Point2f& c : corners) {
         points_.push_back(c + cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y)));
+        motion_.push_back(cv::Point2f(kUnknown, kUnknown));
         ids_.push_back(next_id_++);
       }
     }
@@ -99,20 +236,21 @@ std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int6
   if (static_cast<int>(points_.size()) > max_features) {
     std::vector<size_t> order(points_.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return ids_[a] < ids_[b]; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return ids_[a] < ids_[b]; });
     order.resize(max_features);
     std::sort(order.begin(), order.end());
-    std::vector<cv::Point2f> kept;
+    std::vector<cv::Point2f> kept, kept_motion;
     std::vector<int64_t> kept_ids;
     for (size_t i : order) {
       kept.push_back(points_[i]);
+      kept_motion.push_back(motion_[i]);
       kept_ids.push_back(ids_[i]);
     }
     points_ = std::move(kept);
+    motion_ = std::move(kept_motion);
     ids_ = std::move(kept_ids);
   }
-  previous_ = gray.clone();
-  return matches;
 }
 
 }  // namespace hybrid_vo

@@ -435,6 +435,16 @@ LineFeatures describe_line_segments(const cv::Mat& image, const std::vector<Line
   return valid;
 }
 
+float line_descriptor_distance(const cv::Mat& a, int i, const cv::Mat& b, int j) {
+  if (a.cols != b.cols || a.type() != b.type() || i < 0 || j < 0 || i >= a.rows || j >= b.rows)
+    return std::numeric_limits<float>::infinity();
+  return segment_distances(a.row(i), b.row(j)).at<float>(0, 0);
+}
+
+double max_line_descriptor_distance(const LineMatchingOptions& options, const cv::Mat& descriptors) {
+  return descriptors.depth() == CV_8U ? options.max_hamming : 128.0 * options.max_l2;
+}
+
 LineMatchingOptions video_line_matching_options() {
   LineMatchingOptions options;
   options.detection.detector = LineDetector::kFld;
@@ -466,8 +476,7 @@ std::vector<LineMatch> match_line_features(const LineFeatures& a, const LineFeat
     return matches;
   const cv::Mat distances = segment_distances(a.descriptors, b.descriptors);
   const int n1 = distances.rows, n2 = distances.cols;
-  const bool binary = a.descriptors.depth() == CV_8U;
-  const double max_distance = binary ? options.max_hamming : 128.0 * options.max_l2;
+  const double max_distance = max_line_descriptor_distance(options, a.descriptors);
 
   // Best match in image 1 of every image-2 segment, for the mutual check.
   std::vector<int> backward(n2, -1);

@@ -1,9 +1,9 @@
 #include "hybrid_vo/frontend/visual_odometry.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <future>
 
 #include <opencv2/imgproc.hpp>
 
@@ -12,11 +12,6 @@
 
 namespace hybrid_vo {
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 bool uses_vps(const RelativePoseEstimatorOptions& options) {
   for (const SolverInfo& info : solver_table())
@@ -52,7 +47,10 @@ const char* to_string(VoStatus status) {
 }
 
 VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
-    : options_(options), klt_(options.klt), vp_tracker_(options.vp_tracker),
+    : options_(options),
+      worker_(std::make_unique<WorkerThread>(options.concurrent)),
+      klt_(options.klt),
+      vp_tracker_(options.vp_tracker),
       offset_filter_(options.stereo_offset) {
   if (options_.use_vp_tracker) {
     // The tracker feeds d1 from directions averaged over many frames: trust them as given (they
@@ -61,6 +59,15 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
     options_.estimator.estimator.refinement.refine_vp_directions = false;
     options_.estimator.estimator.refinement.vp_weight = options_.tracked_vp_weight;
   }
+}
+
+VisualOdometry::~VisualOdometry() = default;
+
+std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
+  std::map<int64_t, Eigen::Vector2d> points;
+  for (size_t i = 0; i < klt_.points().size(); ++i)
+    points[klt_.ids()[i]] = Eigen::Vector2d(klt_.points()[i].x, klt_.points()[i].y);
+  return points;
 }
 
 void VisualOdometry::reset() {
@@ -132,35 +139,65 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   }
   last_stamp_ = input.stamp;
   const cv::Mat gray = to_gray8(input.image);
+  StageTimings& times = r.stages;
 
-  // Features of this frame.
+  // Features of this frame: the segments on the second thread while this one does the points.
   std::map<int64_t, Eigen::Vector2d> points;
   ImageFeatures features;
+  WorkerJob lines_job, redetect_job;
+  const bool tracking =
+      !input.external.has_points && options_.point_source == PointFeatureSource::kTracking;
+  if (options_.use_lines && !input.external.has_lines) {
+    lines_job = worker_->submit([&] {
+      const auto lines_start = std::chrono::steady_clock::now();
+      features.lines = detect_line_features(gray, options_.features.lines);
+      times.lines_ms = ms_since(lines_start);
+    });
+  }
+  const auto points_start = std::chrono::steady_clock::now();
   if (input.external.has_points) {
     for (size_t i = 0; i < input.external.points.size() && i < input.external.point_ids.size(); ++i)
       if (all_finite(input.external.points[i]))
         points[input.external.point_ids[i]] = input.external.points[i];
-  } else if (options_.point_source == PointFeatureSource::kTracking) {
-    klt_.track(gray);
-    for (size_t i = 0; i < klt_.points().size(); ++i)
-      points[klt_.ids()[i]] = Eigen::Vector2d(klt_.points()[i].x, klt_.points()[i].y);
+  } else if (tracking) {
+    klt_.track_existing(gray);
+    points = klt_points();
+    // The re-detection serves only the next frame: on the second thread after the segments,
+    // while this one matches and estimates. `points` holds the tracked features until then.
+    redetect_job = worker_->submit([&] {
+      const auto redetect_start = std::chrono::steady_clock::now();
+      klt_.detect_new();
+      times.redetect_ms = ms_since(redetect_start);
+    });
   } else {
     features.points = detect_point_features(gray, options_.features.points);
     for (size_t i = 0; i < features.points.keypoints.size(); ++i)
       points[static_cast<int64_t>(i)] = Eigen::Vector2d(features.points.keypoints[i].pt.x,
                                                         features.points.keypoints[i].pt.y);
   }
-  // Stereo matching of this frame runs on the second core while segments are detected and the
-  // pose is estimated (it is needed only for the scale and the next keyframe).
+  times.points_ms = ms_since(points_start);
+  // Stereo matching of this frame's points (after the re-detection: the next keyframe needs them
+  // all), for the scale of this and the next motion: on the second thread while this one matches
+  // and estimates. Skipped when the frame turns out not to be kept before it starts.
+  std::map<int64_t, Eigen::Vector3d> points3d;
+  std::atomic<bool> skip_stereo{false};
+  WorkerJob stereo_job;
   const bool stereo = !input.right_image.empty() && input.baseline_m > 0.0;
-  std::future<std::map<int64_t, Eigen::Vector3d>> stereo_points_of_frame = std::async(
-      stereo ? std::launch::async : std::launch::deferred,
-      [this, &input, &gray, &points] { return stereo_of(input, gray, points); });
-  if (options_.use_lines && !input.external.has_lines)
-    features.lines = detect_line_features(gray, options_.features.lines);
+  if (stereo) {
+    stereo_job = worker_->submit([&] {
+      if (skip_stereo) return;
+      const auto stereo_start = std::chrono::steady_clock::now();
+      points3d = stereo_of(input, gray, tracking ? klt_points() : points);
+      times.stereo_ms = ms_since(stereo_start);
+    });
+  }
+  lines_job.get();
 
   if (!keyframe_.valid) {
-    make_keyframe(input, points, stereo_points_of_frame.get(), std::move(features));
+    redetect_job.get();
+    stereo_job.get();
+    make_keyframe(input, tracking ? klt_points() : points, std::move(points3d),
+                  std::move(features));
     r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
     r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
     r.reference_stamp = input.stamp;
@@ -191,7 +228,14 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       if (it != keyframe_.external_lines.end()) m.lines.push_back({it->second, input.external.lines[i]});
     }
   } else if (options_.use_lines) {
-    m.lines = match_line_features(keyframe_.features.lines, features.lines, options_.features.lines);
+    const auto matching_start = std::chrono::steady_clock::now();
+    m.lines = options_.track_lines
+                  ? track_line_segments(keyframe_.features.lines, features.lines, m.points,
+                                        options_.features.lines, options_.line_tracking,
+                                        &r.line_tracking)
+                  : match_line_features(keyframe_.features.lines, features.lines,
+                                        options_.features.lines);
+    times.line_matching_ms = ms_since(matching_start);
   }
   r.num_point_matches = static_cast<int>(m.points.size());
   r.num_line_matches = static_cast<int>(m.lines.size());
@@ -199,7 +243,10 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
 
   if (r.num_point_matches < options_.min_point_matches &&
       r.num_line_matches < options_.min_line_matches) {
-    make_keyframe(input, points, stereo_points_of_frame.get(), std::move(features));
+    redetect_job.get();
+    stereo_job.get();
+    make_keyframe(input, tracking ? klt_points() : points, std::move(points3d),
+                  std::move(features));
     r.status = VoStatus::kTooFewFeatures;
     r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
@@ -213,6 +260,9 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     if (motion[motion.size() / 2] < options_.min_parallax_px) {
       r.status = VoStatus::kLowParallax;
       r.message = "median motion " + std::to_string(motion[motion.size() / 2]) + " px";
+      skip_stereo = true;
+      stereo_job.wait();
+      redetect_job.get();
       r.total_ms = ms_since(start);
       return r;
     }
@@ -234,6 +284,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     if (!lines_done) std::swap(distorted.lines, m.lines);
   }
   TwoViewOptions estimator = options_.estimator;
+  const auto vps_start = std::chrono::steady_clock::now();
   if (uses_vps(estimator.estimator) && !m.lines.empty()) {
     VpDetectionOptions vp_options = estimator.vp_detection;
     const MatchedVps vps = estimator.joint_vp_detection
@@ -255,8 +306,11 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       r.vp_track_ids = vp_tracker_.refine_matches(keyframe_.R_wc, &m.vps);
     }
   }
+  times.vps_ms = ms_since(vps_start);
   estimator.detect_vps = false;  // detected above (or unwanted)
+  const auto ransac_start = std::chrono::steady_clock::now();
   r.estimate = estimate_two_view(keyframe_.camera.pinhole, input.camera.pinhole, m, estimator);
+  times.ransac_ms = ms_since(ransac_start);
   r.estimate.vps.matches = m.vps;
   r.estimate.vps.labels = m.line_vp;
   r.estimator_ms = ms_since(estimate_start);
@@ -264,6 +318,9 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   if (est.status != EstimationStatus::kOk) {
     r.status = VoStatus::kNoPose;
     r.message = std::string("estimator: ") + hybrid_vo::to_string(est.status);
+    skip_stereo = true;
+    stereo_job.wait();
+    redetect_job.get();
     r.total_ms = ms_since(start);
     return r;
   }
@@ -271,7 +328,9 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   // Scale: the keyframe's stereo points seen again, with this frame's disparities, fitted in
   // disparity and image space (estimate_stereo_scale); without a usable fit, the configured
   // length and scale_known false.
-  std::map<int64_t, Eigen::Vector3d> current3d = stereo_points_of_frame.get();
+  redetect_job.get();
+  stereo_job.get();
+  std::map<int64_t, Eigen::Vector3d> current3d = std::move(points3d);
   r.motion = est.pose;
   double scale = options_.mono_scale, scale_sigma = 0.0;
   if (stereo) {
@@ -323,7 +382,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     }
     vp_tracker_.update(R_wc_, d2, weights);
   }
-  make_keyframe(input, points, std::move(current3d), std::move(features));
+  make_keyframe(input, tracking ? klt_points() : points, std::move(current3d),
+                std::move(features));
   r.status = VoStatus::kOk;
   r.message = "ok";
   r.total_ms = ms_since(start);

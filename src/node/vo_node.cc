@@ -145,6 +145,9 @@ void VoNode::load_parameters() {
     o.estimator.vp_detection.min_inliers = 6;
   }
   o.use_vp_tracker = pnh_.param("vp_tracker", true);
+  o.track_lines = pnh_.param("track_lines", false);
+  o.klt.predict_motion = pnh_.param("klt_predict_motion", true);
+  o.concurrent = pnh_.param("concurrent_frontend", true);
 }
 
 void VoNode::subscribe() {
@@ -406,6 +409,14 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
   rel.iterations = est.iterations;
   rel.frontend_ms = result.frontend_ms;
   rel.estimator_ms = result.estimator_ms;
+  rel.total_ms = result.total_ms;
+  rel.points_ms = result.stages.points_ms;
+  rel.redetect_ms = result.stages.redetect_ms;
+  rel.lines_ms = result.stages.lines_ms;
+  rel.line_matching_ms = result.stages.line_matching_ms;
+  rel.vps_ms = result.stages.vps_ms;
+  rel.ransac_ms = result.stages.ransac_ms;
+  rel.stereo_ms = result.stages.stereo_ms;
   relative_pose_pub_.publish(rel);
 
   if (moved || result.status == VoStatus::kFirstFrame || result.status == VoStatus::kReset)
@@ -634,6 +645,16 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   if (!last_scale_fallback_.empty()) status.add("last stereo scale fallback", last_scale_fallback_);
   status.add("front end (ms)", r.frontend_ms);
   status.add("estimator (ms)", r.estimator_ms);
+  status.add("total (ms)", r.total_ms);
+  status.add("points (ms)", r.stages.points_ms);
+  status.add("re-detection (ms)", r.stages.redetect_ms);
+  status.add("lines (ms)", r.stages.lines_ms);
+  status.add("line matching (ms)", r.stages.line_matching_ms);
+  status.add("VPs (ms)", r.stages.vps_ms);
+  status.add("RANSAC (ms)", r.stages.ransac_ms);
+  status.add("stereo (ms)", r.stages.stereo_ms);
+  status.add("segments tracked", r.line_tracking.tracked);
+  status.add("segments matched by descriptor", r.line_tracking.fallback);
   status.add("invalid camera_info", invalid_camera_info_);
   status.add("bad images", bad_images_);
   status.add("bad feature messages", bad_features_);

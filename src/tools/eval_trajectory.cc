@@ -266,18 +266,47 @@ int main(int argc, char** argv) {
                 median(scale_ratios), hybrid_vo::tools::percentile(scale_ratios, 0.1),
                 hybrid_vo::tools::percentile(scale_ratios, 0.9), scale_ratios.size());
   // Processing time per frame as the node measured it (MotionEstimate), skipped frames included:
-  // what bounds the frame rate through the node.
-  std::vector<double> frontend_ms, estimator_ms, total_ms;
-  for (const hybrid_vo::MotionEstimate& m : run.motions) {
-    frontend_ms.push_back(m.frontend_ms);
-    estimator_ms.push_back(m.estimator_ms);
-    total_ms.push_back(m.frontend_ms + m.estimator_ms);
-  }
-  if (!total_ms.empty())
+  // what bounds the frame rate through the node. Then where it goes, stage by stage (the stages
+  // overlap: the segments and the stereo matching run on a second thread), and the matches.
+  if (!run.motions.empty()) {
+    std::vector<double> frontend, estimator, total, points, redetect, lines, line_matching, vps,
+        ransac, stereo, point_matches, point_inliers, line_matches, line_inliers;
+    double lines_sum = 0.0, line_inliers_sum = 0.0;
+    for (const hybrid_vo::MotionEstimate& m : run.motions) {
+      frontend.push_back(m.frontend_ms);
+      estimator.push_back(m.estimator_ms);
+      total.push_back(m.total_ms);
+      points.push_back(m.points_ms);
+      redetect.push_back(m.redetect_ms);
+      lines.push_back(m.lines_ms);
+      line_matching.push_back(m.line_matching_ms);
+      vps.push_back(m.vps_ms);
+      ransac.push_back(m.ransac_ms);
+      stereo.push_back(m.stereo_ms);
+      if (m.status != hybrid_vo::MotionEstimate::STATUS_OK) continue;
+      point_matches.push_back(m.points);
+      point_inliers.push_back(m.point_inliers);
+      line_matches.push_back(m.lines);
+      line_inliers.push_back(m.line_inliers);
+      lines_sum += m.lines;
+      line_inliers_sum += m.line_inliers;
+    }
+    std::printf("# frames answered: %zu, of %zu ground-truth poses\n", run.motions.size(),
+                gt.size());
     std::printf("# per frame (median): front end %.1f ms, estimator %.1f ms, total %.1f ms = %.1f "
                 "frames/s\n",
-                median(frontend_ms), median(estimator_ms), median(total_ms),
-                1000.0 / std::max(1e-3, median(total_ms)));
+                median(frontend), median(estimator), median(total),
+                1000.0 / std::max(1e-3, median(total)));
+    std::printf("# per stage (median ms): points %.1f, re-detection %.1f, lines %.1f, line "
+                "matching %.1f, VPs %.1f, RANSAC %.1f, stereo %.1f\n",
+                median(points), median(redetect), median(lines), median(line_matching), median(vps),
+                median(ransac), median(stereo));
+    if (!point_matches.empty())
+      std::printf("# matches per estimated frame (median): points %.0f (%.0f inliers), lines %.0f "
+                  "(%.0f inliers); line inlier ratio %.3f (all frames pooled)\n",
+                  median(point_matches), median(point_inliers), median(line_matches),
+                  median(line_inliers), lines_sum > 0.0 ? line_inliers_sum / lines_sum : 0.0);
+  }
   std::printf("summary: pairs=%zu auc5=%.2f auc10=%.2f auc20=%.2f rpe_trans=%.4f rpe_rot_deg=%.4f "
               "ate=%.4f\n",
               errors.size(), 100.0 * hybrid_vo::pose_auc(errors, 5.0),

@@ -17,6 +17,17 @@ struct KltTrackerOptions {
   int window_px = 21;
   int pyramid_levels = 3;
   double max_forward_backward_px = 1.0;  // forward-backward check of each track
+  int max_iterations = 30;              // Lucas-Kanade iterations per pyramid level
+  // Motion prediction (constant velocity in the image): the search for a feature starts where it
+  // would be if it kept its last image motion (a new feature: the median motion of the tracks in
+  // its grid cell) and spans only `predicted_pyramid_levels` levels above full resolution, instead
+  // of starting at the feature itself and spanning `pyramid_levels`. A feature that the short
+  // search loses is searched for again the long way. The backward search of the
+  // forward-backward check mirrors the forward one: it starts at the found position minus the
+  // predicted motion. On KITTI this keeps 20 % more tracks that agree with the true epipolar
+  // geometry, half as many that do not, and costs a third less (see the README).
+  bool predict_motion = true;
+  int predicted_pyramid_levels = 1;
 };
 
 // Sparse optical-flow tracking of corners between consecutive video frames, with re-detection in
@@ -24,10 +35,15 @@ struct KltTrackerOptions {
 class KltTracker {
  public:
   explicit KltTracker(const KltTrackerOptions& options = {});
-  // Tracks the current features into `image` (grayscale) and re-detects. Returns the matches
-  // between the previous frame and this one (pixels) and their track ids. The first call (or the
-  // first after reset) returns no matches.
+  // Tracks the current features into `image` (grayscale) and re-detects: track_existing, then
+  // detect_new. Returns the matches between the previous frame and this one (pixels) and their
+  // track ids. The first call (or the first after reset) returns no matches.
   std::vector<PointMatch> track(const cv::Mat& image, std::vector<int64_t>* ids = nullptr);
+  // The two halves of track, so that the re-detection, which only the next frame needs, can run
+  // while the caller uses the matches. After track_existing, points() holds the tracked features.
+  std::vector<PointMatch> track_existing(const cv::Mat& image, std::vector<int64_t>* ids = nullptr);
+  // Fills the buckets of the last tracked image that have too few features; appends to points().
+  void detect_new();
   void reset();
   int num_tracks() const;
   // Every feature of the last frame (tracked and newly detected) and its id.
@@ -35,9 +51,15 @@ class KltTracker {
   const std::vector<int64_t>& ids() const { return ids_; }
 
  private:
+  // Where each feature of the previous frame is searched for in the next one; false where there
+  // is no prediction (the search then starts at the feature itself and spans all levels).
+  std::vector<char> predict(std::vector<cv::Point2f>* next) const;
+
   KltTrackerOptions options_;
-  cv::Mat previous_;
+  cv::Size size_;
+  std::vector<cv::Mat> previous_;  // image pyramid with derivatives, built once per frame
   std::vector<cv::Point2f> points_;
+  std::vector<cv::Point2f> motion_;  // per feature: its last image motion, NaN when new
   std::vector<int64_t> ids_;
   int64_t next_id_ = 0;
 };

@@ -93,4 +93,11 @@ std::vector<LineMatch> match_line_features(const LineFeatures& a, const LineFeat
                                            const LineMatchingOptions& options = {},
                                            std::vector<std::pair<int, int>>* pairs = nullptr);
 
+// The LBD distance between row `i` of `a` and row `j` of `b` (descriptors as in LineFeatures), on
+// the scale match_line_features uses: Hamming bits, or 128 x L2 for floats, the smallest over
+// all pairs of octaves. Infinity for mismatched descriptors.
+float line_descriptor_distance(const cv::Mat& a, int i, const cv::Mat& b, int j);
+// The largest LBD distance match_line_features accepts (max_hamming or 128 x max_l2).
+double max_line_descriptor_distance(const LineMatchingOptions& options, const cv::Mat& descriptors);
+
 }  // namespace hybrid_vo

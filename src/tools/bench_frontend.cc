@@ -1,0 +1,151 @@
+// hybrid_vo_bench_frontend: the node's VisualOdometry on a KITTI sequence's left images, without
+// ROS, with the KITTI configuration (config/kitti.yaml). Images are read before the clock starts.
+// Prints per-stage medians, the process CPU time per frame (load-independent enough to compare
+// configurations on a shared machine) and the matches. Under
+// `valgrind --tool=callgrind --toggle-collect='hybrid_vo::VisualOdometry::process*'` with
+// --sequential it gives instruction counts per configuration.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "datasets/kitti.h"
+#include "hybrid_vo/frontend/visual_odometry.h"
+#include "statistics.h"
+
+namespace hybrid_vo {
+namespace {
+
+using tools::median;
+
+void usage(const char* program) {
+  std::cerr << "Usage: " << program
+            << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]\n"
+               "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt).\n"
+               "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
+               "  tracking; --no-predict: KLT without motion prediction. Default preset\n"
+               "  hybrid+junc.\n";
+}
+
+double cpu_ms() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
+
+int run(int argc, char** argv) {
+  if (argc < 2) {
+    usage(argv[0]);
+    return 2;
+  }
+  const std::string dir = argv[1];
+  int frames = -1;
+  std::string preset = "hybrid+junc";
+  VisualOdometryOptions o;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
+    else if (a == "--preset" && i + 1 < argc) preset = argv[++i];
+    else if (a == "--sequential") o.concurrent = false;
+    else if (a == "--lbd") o.track_lines = false;
+    else if (a == "--no-predict") o.klt.predict_motion = false;
+    else {
+      usage(argv[0]);
+      return 2;
+    }
+  }
+  if (!preset_options(preset, &o.estimator.estimator)) {
+    std::cerr << "unknown preset " << preset << "\n";
+    return 2;
+  }
+  // As config/kitti.yaml sets the node.
+  o.klt.max_features = o.features.points.max_features = 1500;
+  o.estimator.vp_detection.min_inliers = 6;
+
+  std::string error;
+  datasets::KittiCalibration calibration;
+  if (!datasets::read_kitti_calibration(dir + "/calib.txt", &calibration, &error)) {
+    std::cerr << error << "\n";
+    return 1;
+  }
+  const int available = datasets::count_kitti_images(dir, 0);
+  if (available <= 0) {
+    std::cerr << dir << "/image_0: no images\n";
+    return 1;
+  }
+  if (frames < 0 || frames > available) frames = available;
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < frames; ++i) {
+    images.push_back(cv::imread(datasets::kitti_image_path(dir, 0, i), cv::IMREAD_GRAYSCALE));
+    if (images.back().empty()) {
+      std::cerr << datasets::kitti_image_path(dir, 0, i) << ": unreadable\n";
+      return 1;
+    }
+  }
+  VisualOdometryInput input;
+  input.camera.pinhole = calibration.P0.camera;
+  input.camera.pinhole.width = images[0].cols;
+  input.camera.pinhole.height = images[0].rows;
+
+  VisualOdometry vo(o);
+  std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
+      cpu, line_matches, line_inliers, tracked, fallback;
+  int ok = 0;
+  double lines_sum = 0.0, inliers_sum = 0.0, searched_sum[2] = {0, 0}, fallback_sum[2] = {0, 0};
+  for (int i = 0; i < frames; ++i) {
+    input.stamp = 1.0 + 0.1 * i;
+    input.image = images[i];
+    const double cpu_start = cpu_ms();
+    const VisualOdometryResult r = vo.process(input);
+    if (i == 0) continue;  // the first frame only initialises
+    cpu.push_back(cpu_ms() - cpu_start);
+    total.push_back(r.total_ms);
+    frontend.push_back(r.frontend_ms);
+    estimator.push_back(r.estimator_ms);
+    points.push_back(r.stages.points_ms);
+    redetect.push_back(r.stages.redetect_ms);
+    lines.push_back(r.stages.lines_ms);
+    matching.push_back(r.stages.line_matching_ms);
+    vps.push_back(r.stages.vps_ms);
+    ransac.push_back(r.stages.ransac_ms);
+    if (r.status != VoStatus::kOk) continue;
+    ++ok;
+    line_matches.push_back(r.num_line_matches);
+    line_inliers.push_back(r.estimate.estimate.num_line_inliers);
+    lines_sum += r.num_line_matches;
+    inliers_sum += r.estimate.estimate.num_line_inliers;
+    // The tracker returns the searched matches first, then the fallback's.
+    const std::vector<char>& inlier = r.estimate.estimate.line_inliers;
+    for (size_t k = 0; k < inlier.size(); ++k) {
+      const bool searched = static_cast<int>(k) < r.line_tracking.tracked;
+      (searched ? searched_sum : fallback_sum)[0] += 1.0;
+      (searched ? searched_sum : fallback_sum)[1] += inlier[k] ? 1.0 : 0.0;
+    }
+    tracked.push_back(r.line_tracking.tracked);
+    fallback.push_back(r.line_tracking.fallback);
+  }
+  std::printf("frames %d, estimated %d (%s, %s, %s)\n", frames, ok,
+              o.concurrent ? "concurrent" : "sequential", o.track_lines ? "line tracking" : "LBD",
+              o.klt.predict_motion ? "KLT prediction" : "KLT plain");
+  std::printf("median ms: total %.1f, front end %.1f, estimator %.1f; points %.1f, "
+              "re-detection %.1f, lines %.1f, "
+              "line matching %.1f, VPs %.1f, RANSAC %.1f; CPU per frame %.1f\n",
+              median(total), median(frontend), median(estimator), median(points), median(redetect),
+              median(lines), median(matching), median(vps), median(ransac), median(cpu));
+  std::printf("median per estimated frame: line matches %.0f, line inliers %.0f, tracked %.0f, "
+              "by LBD fallback %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
+              median(line_matches), median(line_inliers), median(tracked), median(fallback),
+              lines_sum > 0.0 ? inliers_sum / lines_sum : 0.0, lines_sum);
+  if (o.track_lines)
+    std::printf("line inlier ratio (pooled): searched %.3f of %.0f, LBD fallback %.3f of %.0f\n",
+                searched_sum[1] / std::max(1.0, searched_sum[0]), searched_sum[0],
+                fallback_sum[1] / std::max(1.0, fallback_sum[0]), fallback_sum[0]);
+  return 0;
+}
+
+}  // namespace
+}  // namespace hybrid_vo
+
+int main(int argc, char** argv) { return hybrid_vo::run(argc, argv); }
