@@ -24,116 +24,19 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "hybrid_vo/geometry/pose_error.h"
+#include "node_test_utils.h"
 #include "render/sequence.h"
 
 namespace hybrid_vo {
 namespace {
 
+using testing::diagnostic_value;
+using testing::image_of;
+using testing::info_of;
+using testing::NodeHarness;
+using testing::publish_static_camera;
+
 constexpr double kDeg = 180.0 / M_PI;
-
-sensor_msgs::CameraInfo info_of(const PinholeCamera& c, const ros::Time& stamp,
-                                const std::string& frame, double tx = 0.0) {
-  sensor_msgs::CameraInfo info;
-  info.header.stamp = stamp;
-  info.header.frame_id = frame;
-  info.width = c.width;
-  info.height = c.height;
-  info.distortion_model = "plumb_bob";
-  info.D = {0, 0, 0, 0, 0};
-  info.K = {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
-  info.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  info.P = {c.fx, 0, c.cx, tx, 0, c.fy, c.cy, 0, 0, 0, 1, 0};
-  return info;
-}
-
-sensor_msgs::Image image_of(const cv::Mat& gray, const ros::Time& stamp, const std::string& frame) {
-  sensor_msgs::Image m;
-  m.header.stamp = stamp;
-  m.header.frame_id = frame;
-  m.encoding = sensor_msgs::image_encodings::MONO8;
-  m.width = gray.cols;
-  m.height = gray.rows;
-  m.step = gray.cols;
-  m.data.assign(gray.data, gray.data + gray.total());
-  return m;
-}
-
-// Publishes frames and waits for the node's answer to each, so that no frame is dropped.
-class NodeHarness {
- public:
-  NodeHarness() : listener_(buffer_) {
-    ros::NodeHandle nh;
-    left_ = nh.advertise<sensor_msgs::Image>("camera/left/image_raw", 5);
-    left_info_ = nh.advertise<sensor_msgs::CameraInfo>("camera/left/camera_info", 5);
-    right_ = nh.advertise<sensor_msgs::Image>("camera/right/image_raw", 5);
-    right_info_ = nh.advertise<sensor_msgs::CameraInfo>("camera/right/camera_info", 5);
-    points_ = nh.advertise<FeaturePoints>("features/points", 5);
-    lines_ = nh.advertise<FeatureLines>("features/lines", 5);
-    motion_sub_ = nh.subscribe("hybrid_vo/relative_pose", 100, &NodeHarness::on_motion, this);
-    diagnostics_sub_ = nh.subscribe("/diagnostics", 100, &NodeHarness::on_diagnostics, this);
-  }
-
-  bool wait_for_node(double seconds = 20.0) {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < end) {
-      if (left_.getNumSubscribers() > 0 && left_info_.getNumSubscribers() > 0) return true;
-      ros::WallDuration(0.05).sleep();
-    }
-    return false;
-  }
-
-  // Waits for the ~relative_pose message of `stamp`.
-  bool wait_for(const ros::Time& stamp, double seconds = 20.0) {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < end) {
-      ros::spinOnce();
-      if (motions_.count(stamp)) return true;
-      ros::WallDuration(0.005).sleep();
-    }
-    return false;
-  }
-
-  void spin_for(double seconds) {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < end) {
-      ros::spinOnce();
-      ros::WallDuration(0.01).sleep();
-    }
-  }
-
-  void on_motion(const MotionEstimate::ConstPtr& m) { motions_[m->header.stamp] = *m; }
-  void on_diagnostics(const diagnostic_msgs::DiagnosticArray::ConstPtr& d) {
-    for (const auto& s : d->status)
-      if (s.name.find("odometry") != std::string::npos) last_odometry_status_ = s;
-  }
-
-  ros::Publisher left_, left_info_, right_, right_info_, points_, lines_;
-  ros::Subscriber motion_sub_, diagnostics_sub_;
-  std::map<ros::Time, MotionEstimate> motions_;
-  diagnostic_msgs::DiagnosticStatus last_odometry_status_;
-  tf2_ros::Buffer buffer_;
-  tf2_ros::TransformListener listener_;
-  tf2_ros::StaticTransformBroadcaster static_broadcaster_;
-};
-
-void publish_static_camera(NodeHarness* h) {
-  geometry_msgs::TransformStamped t;
-  t.header.stamp = ros::Time::now();
-  t.header.frame_id = "base_link";
-  t.child_frame_id = "camera_left_optical";
-  const Eigen::Quaterniond q(render::base_from_optical());
-  t.transform.rotation.w = q.w();
-  t.transform.rotation.x = q.x();
-  t.transform.rotation.y = q.y();
-  t.transform.rotation.z = q.z();
-  h->static_broadcaster_.sendTransform(t);
-}
-
-double diagnostic_value(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {
-  for (const auto& kv : s.values)
-    if (kv.key == key) return std::atof(kv.value.c_str());
-  return -1.0;
-}
 
 // The base's pose in odom implied by the ground truth (odom = the base at frame 0).
 Eigen::Isometry3d gt_odom_base(const render::Sequence& seq, int first, int frame) {

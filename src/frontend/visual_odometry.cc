@@ -71,12 +71,16 @@ std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
 }
 
 void VisualOdometry::reset() {
-  klt_.reset();
-  vp_tracker_.reset();
-  keyframe_ = Keyframe();
+  restart();
   R_wc_.setIdentity();
   centre_.setZero();
   last_stamp_ = -1e300;
+}
+
+void VisualOdometry::restart() {
+  klt_.reset();
+  vp_tracker_.reset();
+  keyframe_ = Keyframe();
   tracker_seeded_ = false;
 }
 

@@ -43,11 +43,38 @@ bool camera_from_info(const sensor_msgs::CameraInfo& info, CameraModel* camera,
 }
 
 bool baseline_from_info(const sensor_msgs::CameraInfo& right, double* baseline) {
+  // Tx = -fx * baseline; an infinite fx, or a ratio that under- or overflows, is no baseline.
   const double fx = right.P[0], tx = right.P[3];
-  if (!(fx > 0.0) || !std::isfinite(tx) || tx == 0.0) return false;
-  *baseline = std::abs(tx / fx);
+  if (!(fx > 0.0) || !std::isfinite(fx) || !std::isfinite(tx)) return false;
+  const double b = std::abs(tx / fx);
+  if (!(b > 0.0) || !std::isfinite(b)) return false;
+  *baseline = b;
   return true;
 }
+
+namespace {
+
+// mono16 in the message's byte order to 8 bits. cv_bridge returns a big-endian image on a
+// little-endian host as a two-channel 8-bit Mat (it byte-swaps but never reinterprets the
+// result), so the swap is done here.
+cv::Mat gray_from_mono16(const sensor_msgs::Image& image) {
+  const int rows = static_cast<int>(image.height), cols = static_cast<int>(image.width);
+  uint8_t* data = const_cast<uint8_t*>(image.data.data());  // read only
+  const bool host_big_endian = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+  cv::Mat native(rows, cols, CV_16UC1, data, image.step);
+  if (static_cast<bool>(image.is_bigendian) != host_big_endian) {
+    const cv::Mat bytes(rows, cols, CV_8UC2, data, image.step);
+    native = cv::Mat(rows, cols, CV_16UC1);
+    cv::Mat swapped(rows, cols, CV_8UC2, native.data, native.step);
+    const int from_to[] = {0, 1, 1, 0};
+    cv::mixChannels(&bytes, 1, &swapped, 1, from_to, 2);
+  }
+  cv::Mat gray;
+  native.convertTo(gray, CV_8U, 1.0 / 256.0);
+  return gray;
+}
+
+}  // namespace
 
 bool gray_from_image(const sensor_msgs::ImageConstPtr& image, cv::Mat* gray, std::string* reason) {
   namespace enc = sensor_msgs::image_encodings;
@@ -61,12 +88,33 @@ bool gray_from_image(const sensor_msgs::ImageConstPtr& image, cv::Mat* gray, std
     *reason = "unsupported encoding '" + e + "'";
     return false;
   }
+  // cv_bridge checks step and size in 32-bit arithmetic, which wraps: a height * step or a
+  // width * pixel size beyond 4 GB passes its checks and the pixels are read past the data.
+  constexpr uint32_t kMaxSide = 1u << 16;
+  if (image->width > kMaxSide || image->height > kMaxSide) {
+    *reason = "image size " + std::to_string(image->width) + "x" + std::to_string(image->height) +
+              " beyond " + std::to_string(kMaxSide) + " pixels a side";
+    return false;
+  }
+  const uint64_t row = static_cast<uint64_t>(image->width) * (enc::bitDepth(e) / 8) *
+                       enc::numChannels(e);
+  const int bytes_per_value = enc::bitDepth(e) / 8;
+  // OpenCV throws on a row step that is not a whole number of 16-bit values.
+  if (image->step < row || image->step % bytes_per_value != 0 ||
+      static_cast<uint64_t>(image->step) * image->height != image->data.size()) {
+    *reason = "malformed image: step " + std::to_string(image->step) + " for " +
+              std::to_string(row) + " bytes a row and " + std::to_string(image->data.size()) +
+              " bytes for " + std::to_string(image->height) + " rows";
+    return false;
+  }
   try {
+    if (e == enc::MONO16) {
+      *gray = gray_from_mono16(*image);
+      return !gray->empty();
+    }
     const cv_bridge::CvImageConstPtr cv = cv_bridge::toCvShare(image);
     if (e == enc::MONO8) {
       *gray = cv->image.clone();
-    } else if (e == enc::MONO16) {
-      cv->image.convertTo(*gray, CV_8U, 1.0 / 256.0);
     } else if (e == enc::BGR8) {
       cv::cvtColor(cv->image, *gray, cv::COLOR_BGR2GRAY);
     } else if (e == enc::RGB8) {
@@ -78,6 +126,9 @@ bool gray_from_image(const sensor_msgs::ImageConstPtr& image, cv::Mat* gray, std
     }
   } catch (const cv_bridge::Exception& ex) {
     *reason = std::string("cv_bridge: ") + ex.what();
+    return false;
+  } catch (const cv::Exception& ex) {
+    *reason = std::string("OpenCV: ") + ex.what();
     return false;
   }
   return !gray->empty();
@@ -130,6 +181,14 @@ const sensor_msgs::ChannelFloat32* channel(const sensor_msgs::PointCloud& msg, s
   return &msg.channels[index];
 }
 
+// VINS ids are floats; one that is not a finite integer would turn into an arbitrary id shared by
+// every such feature, i.e. false matches between frames.
+bool vins_id(float value, int64_t* id) {
+  if (!(std::abs(value) < 9.0e15f) || value != std::round(value)) return false;
+  *id = static_cast<int64_t>(value);
+  return true;
+}
+
 }  // namespace
 
 bool points_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& camera,
@@ -141,10 +200,11 @@ bool points_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& c
   f->points.clear();
   f->point_ids.clear();
   for (size_t i = 0; i < msg.points.size(); ++i) {
-    const Eigen::Vector2d n(msg.points[i].x, msg.points[i].y);
-    if (!all_finite(n)) continue;
-    f->points.push_back(camera.denormalize(n));
-    f->point_ids.push_back(static_cast<int64_t>(std::llround(ids->values[i])));
+    const Eigen::Vector2d p = camera.denormalize({msg.points[i].x, msg.points[i].y});
+    int64_t id = 0;
+    if (!all_finite(p) || !vins_id(ids->values[i], &id)) continue;
+    f->points.push_back(p);
+    f->point_ids.push_back(id);
   }
   return true;
 }
@@ -162,9 +222,12 @@ bool lines_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& ca
   for (size_t i = 0; i < msg.points.size(); ++i) {
     const LineSegment s(camera.denormalize({msg.points[i].x, msg.points[i].y}),
                         camera.denormalize({ex->values[i], ey->values[i]}));
-    if (!all_finite(s.p1) || !all_finite(s.p2) || !(s.length() > 0.0)) continue;
+    int64_t id = 0;
+    if (!all_finite(s.p1) || !all_finite(s.p2) || !(s.length() > 0.0) ||
+        !vins_id(ids->values[i], &id))
+      continue;
     f->lines.push_back(s);
-    f->line_ids.push_back(static_cast<int64_t>(std::llround(ids->values[i])));
+    f->line_ids.push_back(id);
   }
   return true;
 }

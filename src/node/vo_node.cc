@@ -62,6 +62,7 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), pnh_(private_nh), it_(nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
   load_parameters();
   vo_ = std::make_unique<VisualOdometry>(vo_options_);
+  queue_ = std::make_unique<FrameQueue<Frame>>(frame_queue_size_);
 
   relative_pose_pub_ = pnh_.advertise<MotionEstimate>("relative_pose", 10);
   odometry_pub_ = pnh_.advertise<nav_msgs::Odometry>("odometry", 10);
@@ -80,6 +81,7 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   subscribe();
   reset_service_ = pnh_.advertiseService("reset", &VoNode::reset_callback, this);
   watchdog_timer_ = nh_.createTimer(ros::Duration(0.5), &VoNode::watchdog, this);
+  worker_ = std::thread(&VoNode::run, this);
   ROS_INFO("hybrid_vo: %s, %s sync, preset %s, points %s, lines %s%s%s",
            stereo_ ? "stereo" : "mono", approximate_sync_ ? "approximate" : "exact",
            pnh_.param<std::string>("preset", "hybrid").c_str(),
@@ -87,6 +89,11 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
            vo_options_.use_lines ? pnh_.param<std::string>("lines", "fld").c_str() : "none",
            use_feature_points_ ? ", point features from features/points" : "",
            use_feature_lines_ ? ", line features from features/lines" : "");
+}
+
+VoNode::~VoNode() {
+  queue_->close();
+  if (worker_.joinable()) worker_.join();
 }
 
 void VoNode::load_parameters() {
@@ -108,6 +115,19 @@ void VoNode::load_parameters() {
   if (format != "native" && format != "vins")
     ROS_WARN("hybrid_vo: feature_format '%s' unknown, using 'native'", format.c_str());
   if (queue_size_ < 1) queue_size_ = 1;
+  pnh_.param("frame_queue_size", frame_queue_size_, 1);
+  if (frame_queue_size_ < 1) {
+    ROS_WARN("hybrid_vo: frame_queue_size must be >= 1, using 1");
+    frame_queue_size_ = 1;
+  }
+  pnh_.param("path_max_poses", path_max_poses_, 5000);
+  StreamMonitorOptions stream;
+  pnh_.param("max_frame_gap", stream.max_gap_s, 1.0);
+  if (!(stream.max_gap_s > 0.0)) {
+    ROS_WARN("hybrid_vo: max_frame_gap must be > 0 s, using 1");
+    stream.max_gap_s = 1.0;
+  }
+  monitor_ = StreamMonitor(stream);
 
   VisualOdometryOptions& o = vo_options_;
   const std::string preset = pnh_.param<std::string>("preset", "hybrid");
@@ -153,11 +173,15 @@ void VoNode::load_parameters() {
 void VoNode::subscribe() {
   const std::string left = stereo_ ? "left/image" : "image";
   const std::string left_info = stereo_ ? "left/camera_info" : "camera_info";
-  left_sub_.subscribe(it_, left, queue_size_);
-  left_info_sub_.subscribe(nh_, left_info, queue_size_);
+  // TCP_NODELAY: without it Nagle's algorithm holds a small camera_info (or the last segment of
+  // an image) until the previous one is acknowledged, which adds up to 40 ms per frame.
+  const ros::TransportHints no_delay = ros::TransportHints().tcpNoDelay();
+  const image_transport::TransportHints image_hints("raw", no_delay);
+  left_sub_.subscribe(it_, left, queue_size_, image_hints);
+  left_info_sub_.subscribe(nh_, left_info, queue_size_, no_delay);
   if (stereo_) {
-    right_sub_.subscribe(it_, "right/image", queue_size_);
-    right_info_sub_.subscribe(nh_, "right/camera_info", queue_size_);
+    right_sub_.subscribe(it_, "right/image", queue_size_, image_hints);
+    right_info_sub_.subscribe(nh_, "right/camera_info", queue_size_, no_delay);
     if (approximate_sync_) {
       approx_stereo_ = std::make_unique<message_filters::Synchronizer<ApproxStereo>>(
           ApproxStereo(queue_size_), left_sub_, left_info_sub_, right_sub_, right_info_sub_);
@@ -177,22 +201,25 @@ void VoNode::subscribe() {
     exact_mono_->registerCallback(&VoNode::mono_callback, this);
   }
   // A second, unsynchronised subscription tells "no images" from "images without camera_info".
-  raw_image_sub_ = nh_.subscribe(left, 1, &VoNode::raw_image_callback, this);
+  raw_image_sub_ = nh_.subscribe(left, 1, &VoNode::raw_image_callback, this, no_delay);
   if (use_feature_points_) {
-    points_sub_ = vins_format_
-                      ? nh_.subscribe("features/points", queue_size_, &VoNode::vins_points_callback, this)
-                      : nh_.subscribe("features/points", queue_size_, &VoNode::points_callback, this);
+    points_sub_ = vins_format_ ? nh_.subscribe("features/points", queue_size_,
+                                               &VoNode::vins_points_callback, this, no_delay)
+                               : nh_.subscribe("features/points", queue_size_,
+                                               &VoNode::points_callback, this, no_delay);
   }
   if (use_feature_lines_) {
-    lines_sub_ = vins_format_
-                     ? nh_.subscribe("features/lines", queue_size_, &VoNode::vins_lines_callback, this)
-                     : nh_.subscribe("features/lines", queue_size_, &VoNode::lines_callback, this);
+    lines_sub_ = vins_format_ ? nh_.subscribe("features/lines", queue_size_,
+                                              &VoNode::vins_lines_callback, this, no_delay)
+                              : nh_.subscribe("features/lines", queue_size_,
+                                              &VoNode::lines_callback, this, no_delay);
   }
 }
 
 void VoNode::raw_image_callback(const sensor_msgs::ImageConstPtr& image) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_raw_image_ = ros::Time::now();
+  ++unsynced_images_;
 }
 
 VoNode::Frame& VoNode::pending(const ros::Time& stamp) {
@@ -201,6 +228,7 @@ VoNode::Frame& VoNode::pending(const ros::Time& stamp) {
   // A bounded wait: features or images that never complete a frame are dropped, oldest first.
   while (pending_.size() > 50) {
     pending_.erase(pending_.begin());
+    std::lock_guard<std::mutex> lock(stats_mutex_);
     ++dropped_;
   }
   return pending_[stamp];
@@ -210,6 +238,7 @@ void VoNode::mono_callback(const sensor_msgs::ImageConstPtr& image,
                            const sensor_msgs::CameraInfoConstPtr& info) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_synced_image_ = ros::Time::now();
+  unsynced_images_ = 0;
   Frame& f = pending(image->header.stamp);
   f.left = image;
   f.left_info = info;
@@ -224,6 +253,7 @@ void VoNode::stereo_callback(const sensor_msgs::ImageConstPtr& left,
                              const sensor_msgs::CameraInfoConstPtr& right_info) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_synced_image_ = ros::Time::now();
+  unsynced_images_ = 0;
   Frame& f = pending(left->header.stamp);
   f.left = left;
   f.left_info = left_info;
@@ -273,16 +303,35 @@ void VoNode::try_process(const ros::Time& stamp) {
   if (!f.have_images || (use_feature_points_ && !f.have_points) ||
       (use_feature_lines_ && !f.have_lines))
     return;
-  const Frame frame = f;
+  Frame frame = f;
+  frame.received = std::chrono::steady_clock::now();
   // Everything up to this stamp is either this frame or can no longer be completed in order.
+  int incomplete = 0;
   for (auto p = pending_.begin(); p != pending_.end() && p->first <= stamp;) {
-    if (p->first < stamp) ++dropped_;
+    if (p->first < stamp) ++incomplete;
     p = pending_.erase(p);
   }
-  process(frame);
+  if (incomplete > 0) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    dropped_ += incomplete;
+  }
+  queue_->push(std::move(frame));
+}
+
+void VoNode::run() {
+  Frame frame;
+  while (queue_->pop(&frame)) {
+    {
+      std::lock_guard<std::mutex> lock(process_mutex_);
+      process(frame);
+    }
+    frame = Frame();  // the images are not kept while waiting
+  }
 }
 
 void VoNode::reject(const std::string& what, const std::string& reason, int* counter) {
+  monitor_.reject();
+  std::lock_guard<std::mutex> lock(stats_mutex_);
   ++*counter;
   last_problem_ = what + ": " + reason;
   ROS_WARN_THROTTLE(2.0, "hybrid_vo: skipping frame, %s", last_problem_.c_str());
@@ -291,7 +340,6 @@ void VoNode::reject(const std::string& what, const std::string& reason, int* cou
 void VoNode::reset_state(const std::string& why) {
   vo_->reset();
   path_.poses.clear();
-  last_processed_ = ros::Time();
   looked_up_base_ = false;
   have_base_transform_ = false;
   last_pose_stamp_ = ros::Time();
@@ -299,19 +347,46 @@ void VoNode::reset_state(const std::string& why) {
 }
 
 bool VoNode::reset_callback(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  pending_.clear();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    pending_.clear();
+  }
+  queue_->clear();
+  std::lock_guard<std::mutex> lock(process_mutex_);
+  monitor_.reset();
   reset_state("reset service");
   return true;
 }
 
-void VoNode::process(const Frame& frame) {
-  if (!last_processed_.isZero() && frame.stamp < last_processed_) {
-    ++time_jumps_;
-    pending_.clear();
-    reset_state("time went backwards by " + std::to_string((last_processed_ - frame.stamp).toSec()) +
-                " s");
+bool VoNode::handle_stream_event(const ros::Time& stamp, int width, int height, bool* lost) {
+  const StreamEvent event = monitor_.classify(stamp.toSec(), width, height);
+  *lost = event == StreamEvent::kBackwards || restarts(event);
+  const std::string& what = monitor_.description();
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stream_counters_ = monitor_.counters();
+    if (!what.empty()) last_problem_ = what;
   }
+  if (skips(event)) {
+    ROS_WARN_THROTTLE(2.0, "hybrid_vo: %s", what.c_str());
+    return false;
+  }
+  if (event == StreamEvent::kBackwards) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pending_.clear();
+    }
+    reset_state(what);
+  } else if (restarts(event)) {
+    vo_->restart();
+    last_pose_stamp_ = ros::Time();  // no velocity across the fault
+    ROS_WARN("hybrid_vo: %s", what.c_str());
+  }
+  return true;
+}
+
+void VoNode::process(const Frame& frame) {
+  // Input checks first, so that a corrupt image's size or stamp never counts as a stream event.
   VisualOdometryInput input;
   input.stamp = frame.stamp.toSec();
   std::string reason;
@@ -344,32 +419,44 @@ void VoNode::process(const Frame& frame) {
                                  : lines_from_msg(*frame.lines, &input.external, &reason);
     if (!ok) return reject("features/lines", reason, &bad_features_);
   }
+  bool lost = false;
+  if (!handle_stream_event(frame.stamp, input.image.cols, input.image.rows, &lost)) return;
 
   const VisualOdometryResult result = vo_->process(input);
+  monitor_.accept(input.image.cols, input.image.rows);
   frequency_->tick();
-  ++frames_;
-  last_processed_ = frame.stamp;
-  last_result_ = result;
-  if (result.status == VoStatus::kOk || result.status == VoStatus::kFirstFrame ||
-      result.status == VoStatus::kLowParallax) {
-    last_problem_.clear();
-  } else {
-    ++failures_;
-    last_problem_ = std::string(to_string(result.status)) + ": " + result.message;
-    ROS_WARN_THROTTLE(2.0, "hybrid_vo: %s", last_problem_.c_str());
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++frames_;
+    last_processed_ = frame.stamp;
+    last_result_ = result;
+    if (result.status == VoStatus::kOk || result.status == VoStatus::kFirstFrame ||
+        result.status == VoStatus::kLowParallax) {
+      // The fault that restarted the chain stays in the summary until a frame pairs again.
+      if (!lost) last_problem_.clear();
+    } else {
+      ++failures_;
+      last_problem_ = std::string(to_string(result.status)) + ": " + result.message;
+      ROS_WARN_THROTTLE(2.0, "hybrid_vo: %s", last_problem_.c_str());
+    }
   }
   if (result.stereo_scale_attempted && !result.scale_known) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
     ++stereo_scale_fallbacks_;
     last_scale_fallback_ = to_string(result.stereo_scale.status);
     ROS_WARN_THROTTLE(5.0, "hybrid_vo: stereo scale: %s (%d near points); mono_scale used",
                       last_scale_fallback_.c_str(), result.stereo_scale.near_points);
   }
-  publish(frame, input, result);
-  updater_.update();
+  publish(frame, input, result, lost);
+  const double latency_ms = std::chrono::duration<double, std::milli>(
+                                std::chrono::steady_clock::now() - frame.received)
+                                .count();
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  latency_ms_.add(latency_ms);
 }
 
 void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
-                     const VisualOdometryResult& result) {
+                     const VisualOdometryResult& result, bool lost) {
   camera_frame_ = frame.frame_id;
   const RelativePoseEstimate& est = result.estimate.estimate;
 
@@ -379,8 +466,9 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
   rel.reference_stamp = ros::Time(result.reference_stamp);
   rel.reference_frame_id = frame.frame_id;
   rel.status = status_code(result);
-  rel.status_text = std::string(to_string(result.status)) +
-                    (result.message.empty() ? "" : ": " + result.message);
+  const std::string& message = lost ? monitor_.description() : result.message;
+  rel.status_text =
+      std::string(to_string(result.status)) + (message.empty() ? "" : ": " + message);
   const bool moved = result.status == VoStatus::kOk;
   rel.transform = moved ? to_transform(result.motion.R, result.motion.t)
                         : to_transform(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
@@ -420,7 +508,7 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
   relative_pose_pub_.publish(rel);
 
   if (moved || result.status == VoStatus::kFirstFrame || result.status == VoStatus::kReset)
-    publish_pose(frame.stamp, frame.frame_id, result);
+    publish_pose(frame.stamp, frame.frame_id, result, lost);
 
   // Tracked VPs, in the odometry frame (the first camera's frame turned into odom_frame).
   const Eigen::Matrix3d R_odom_world = have_base_transform_ ? R_base_camera_
@@ -524,7 +612,7 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
 }
 
 void VoNode::publish_pose(const ros::Time& stamp, const std::string& camera_frame,
-                          const VisualOdometryResult& result) {
+                          const VisualOdometryResult& result, bool lost) {
   if (!looked_up_base_) {
     // The body frame sits at the camera through a (static) transform; odom starts at the body.
     looked_up_base_ = true;
@@ -567,6 +655,12 @@ void VoNode::publish_pose(const ros::Time& stamp, const std::string& camera_fram
   odometry.pose.pose.position.y = pose.translation().y();
   odometry.pose.pose.position.z = pose.translation().z();
   odometry.pose.pose.orientation = tf.transform.rotation;
+  if (lost) {
+    for (int i = 0; i < 6; ++i) {
+      odometry.pose.covariance[i * 7] = 9999.0;
+      odometry.twist.covariance[i * 7] = 9999.0;
+    }
+  }
   if (!last_pose_stamp_.isZero() && stamp > last_pose_stamp_) {
     const double dt = (stamp - last_pose_stamp_).toSec();
     const Eigen::Vector3d velocity =
@@ -582,28 +676,43 @@ void VoNode::publish_pose(const ros::Time& stamp, const std::string& camera_fram
   p.pose = odometry.pose.pose;
   path_.header = tf.header;
   path_.poses.push_back(p);
-  if (path_.poses.size() > 20000) path_.poses.erase(path_.poses.begin());
+  // A bounded window: the latched path is serialised on every frame, so an unbounded one would
+  // cost more memory and time with every frame of a long run.
+  if (path_max_poses_ > 0 && path_.poses.size() > static_cast<size_t>(path_max_poses_))
+    path_.poses.erase(path_.poses.begin(), path_.poses.end() - path_max_poses_);
   path_pub_.publish(path_);
 }
 
 void VoNode::watchdog(const ros::TimerEvent&) {
-  std::lock_guard<std::mutex> lock(mutex_);
   const ros::Time now = ros::Time::now();
-  const bool images_flow =
-      !last_raw_image_.isZero() && (now - last_raw_image_).toSec() < camera_info_timeout_;
-  const bool frames_flow =
-      !last_synced_image_.isZero() && (now - last_synced_image_).toSec() < camera_info_timeout_;
-  if (images_flow && !frames_flow) {
-    last_problem_ = "images arrive without a matching camera_info" +
-                    std::string(stereo_ ? " (or without their stereo partner)" : "");
-    ++invalid_camera_info_;
-    ROS_WARN_THROTTLE(5.0, "hybrid_vo: %s", last_problem_.c_str());
+  bool images_flow = false, frames_flow = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    images_flow =
+        !last_raw_image_.isZero() && (now - last_raw_image_).toSec() < camera_info_timeout_;
+    // A few images in a row, not one that is waiting for its camera_info after a pause.
+    frames_flow = unsynced_images_ < 3 || (!last_synced_image_.isZero() &&
+                                           (now - last_synced_image_).toSec() < camera_info_timeout_);
+  }
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    if (images_flow && !frames_flow) {
+      last_problem_ = "images arrive without a matching camera_info" +
+                      std::string(stereo_ ? " (or without their stereo partner)" : "");
+      // One outage, however long; the frame after it restarts the chain (a time gap).
+      if (!camera_info_outage_) ++camera_info_outages_;
+      camera_info_outage_ = true;
+      ROS_WARN_THROTTLE(5.0, "hybrid_vo: %s", last_problem_.c_str());
+    } else if (frames_flow) {
+      camera_info_outage_ = false;
+    }
   }
   updater_.update();
 }
 
 void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
+  std::lock_guard<std::mutex> lock(stats_mutex_);
   const VisualOdometryResult& r = last_result_;
   unsigned char level = DiagnosticStatus::OK;
   std::string summary = frames_ == 0 ? "waiting for images" : "tracking";
@@ -658,9 +767,22 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   status.add("invalid camera_info", invalid_camera_info_);
   status.add("bad images", bad_images_);
   status.add("bad feature messages", bad_features_);
-  status.add("time jumps (resets)", time_jumps_);
   status.add("frames without pose", failures_);
   status.add("incomplete frames dropped", dropped_);
+  // Load: frames dropped because the processing thread was busy, and the time from a frame's
+  // arrival to its publication over the last 200 frames.
+  status.add("frames dropped (queue full)", queue_->dropped());
+  status.add("queue length", queue_->size());
+  status.add("latency p50 (ms)", latency_ms_.quantile(0.5));
+  status.add("latency p99 (ms)", latency_ms_.quantile(0.99));
+  // Faults in the stream (stream_monitor.h).
+  status.add("time jumps (resets)", stream_counters_.backwards);
+  status.add("time gaps (restarts)", stream_counters_.gaps);
+  status.add("image size changes (restarts)", stream_counters_.size_changes);
+  status.add("restarts after rejected input", stream_counters_.after_faults);
+  status.add("duplicate stamps skipped", stream_counters_.duplicates);
+  status.add("late frames skipped", stream_counters_.late);
+  status.add("camera_info outages", camera_info_outages_);
 }
 
 }  // namespace hybrid_vo

@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
 
     const double tx_right = -seq.camera.fx * options.baseline;
     double render_seconds = 0.0;
-    for (int i = 0; i < options.frames; ++i) {
+    for (int i = 0; i < seq.options.frames; ++i) {
       const ros::Time t = stamp_of(i, options.rate);
       for (int side = 0; side < (options.stereo ? 2 : 1); ++side) {
         const bool is_right = side == 1;
@@ -118,11 +118,11 @@ int main(int argc, char** argv) {
     }
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
-    const int views = options.frames * (options.stereo ? 2 : 1);
+    const int views = seq.options.frames * (options.stereo ? 2 : 1);
     std::printf(
         "rendered %d frames (%s, %dx%d, %s, %.0f Hz), path %.1f m, turned %.0f deg, "
         "%.3f s per view, %.1f s total -> %s\n",
-        options.frames, options.stereo ? "stereo" : "mono", options.width, options.height,
+        seq.options.frames, options.stereo ? "stereo" : "mono", options.width, options.height,
         to_string(options.scene), options.rate, seq.trajectory.length,
         seq.trajectory.total_turn_deg, render_seconds / views, total, options.out_bag.c_str());
   } catch (const rosbag::BagException& e) {

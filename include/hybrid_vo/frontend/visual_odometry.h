@@ -130,6 +130,11 @@ class VisualOdometry {
   ~VisualOdometry();
   VisualOdometryResult process(const VisualOdometryInput& input);
   void reset();
+  // Starts a new keyframe chain at the next frame but keeps the pose: after a fault in the stream
+  // (a time gap, a new image size, rejected frames) the motion across it is unknown, so nothing
+  // may be paired across it, yet the odometry goes on from where it was. VP tracks are dropped
+  // too: their directions would be compared under a rotation that no longer holds.
+  void restart();
   const VpTracker& vp_tracker() const { return vp_tracker_; }
   const VisualOdometryOptions& options() const { return options_; }
 

@@ -21,11 +21,13 @@ namespace hybrid_vo {
 bool camera_from_info(const sensor_msgs::CameraInfo& info, CameraModel* camera,
                       std::string* reason);
 
-// Stereo baseline in metres from the right camera's projection matrix (P[3] = -fx * B).
+// Stereo baseline in metres from the right camera's projection matrix (P[3] = -fx * B). False
+// when fx or Tx give no finite positive baseline.
 bool baseline_from_info(const sensor_msgs::CameraInfo& right, double* baseline);
 
 // An image as 8-bit grayscale (mono8, mono16, bgr8, rgb8, bgra8, rgba8). False with a reason for
-// an empty image or another encoding.
+// an empty image, another encoding, more than 65536 pixels a side, or a step and data size that
+// do not fit the width, height and encoding.
 bool gray_from_image(const sensor_msgs::ImageConstPtr& image, cv::Mat* gray, std::string* reason);
 
 // Feature messages to external features (pixels). Mismatched array sizes are an error.
@@ -34,7 +36,8 @@ bool lines_from_msg(const FeatureLines& msg, ExternalFeatures* features, std::st
 
 // The VINS-Mono / PL-VINS encodings (sensor_msgs/PointCloud with undistorted normalised
 // coordinates): points carry channels [id, u, v, ...], lines a start point and channels
-// [id, end x, end y], both normalised. Converted to undistorted pixels with the camera.
+// [id, end x, end y], both normalised. Converted to undistorted pixels with the camera. Features
+// with non-finite coordinates or an id that is not a finite integer are skipped.
 bool points_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& camera,
                       ExternalFeatures* features, std::string* reason);
 bool lines_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& camera,

@@ -1,9 +1,12 @@
 #pragma once
 
+#include <atomic>
+#include <chrono>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
@@ -26,19 +29,25 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/node/frame_queue.h"
+#include "hybrid_vo/node/latency_window.h"
+#include "hybrid_vo/node/stream_monitor.h"
 
 namespace hybrid_vo {
 
 // The ROS wrapper around VisualOdometry: synchronised image (+ camera_info) input, mono or stereo,
 // optional feature topics, and the outputs of DESIGN.md "The node". Usable from a node's main()
-// or from the nodelet.
+// or from the nodelet. Callbacks only assemble frames and hand them to a processing thread
+// through a bounded queue (frame_queue.h), so that a slow frame never backs up the subscribers.
 class VoNode {
  public:
   VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  ~VoNode();
 
  private:
   struct Frame {
     ros::Time stamp;
+    std::chrono::steady_clock::time_point received;  // when it was complete
     std::string frame_id;
     sensor_msgs::ImageConstPtr left, right;
     sensor_msgs::CameraInfoConstPtr left_info, right_info;
@@ -67,11 +76,18 @@ class VoNode {
   // Frames wait here until every part (images, and the feature topics in use) has arrived.
   Frame& pending(const ros::Time& stamp);
   void try_process(const ros::Time& stamp);
+  // The processing thread: frames from the queue, one at a time, in arrival order.
+  void run();
   void process(const Frame& frame);
+  // Resets or restarts the odometry for a fault in the stream (a valid frame of this stamp and
+  // size); false to skip the frame.
+  bool handle_stream_event(const ros::Time& stamp, int width, int height, bool* lost);
   void publish(const Frame& frame, const VisualOdometryInput& input,
-               const VisualOdometryResult& result);
+               const VisualOdometryResult& result, bool lost);
+  // `lost`: the pose follows a fault in the stream, so its covariance says "unknown" (9999, as
+  // viso2 reports a lost track).
   void publish_pose(const ros::Time& stamp, const std::string& camera_frame,
-                    const VisualOdometryResult& result);
+                    const VisualOdometryResult& result, bool lost);
   void reject(const std::string& what, const std::string& reason, int* counter);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   void reset_state(const std::string& why);
@@ -85,6 +101,8 @@ class VoNode {
   bool use_feature_points_ = false, use_feature_lines_ = false, vins_format_ = false;
   bool publish_debug_image_ = true, publish_markers_ = true;
   int queue_size_ = 10;
+  int frame_queue_size_ = 1;
+  int path_max_poses_ = 5000;
   double camera_info_timeout_ = 2.0;
   VisualOdometryOptions vo_options_;
 
@@ -115,11 +133,17 @@ class VoNode {
   tf2_ros::TransformListener tf_listener_;
   nav_msgs::Path path_;
 
-  // State.
+  // Input side (callbacks): partial frames and arrival times, under mutex_.
   std::mutex mutex_;
-  std::unique_ptr<VisualOdometry> vo_;
   std::map<ros::Time, Frame> pending_;
-  ros::Time last_processed_;
+  std::unique_ptr<FrameQueue<Frame>> queue_;
+  std::thread worker_;
+
+  // Processing side: only the processing thread (or the reset service, under process_mutex_)
+  // touches the odometry and the publishers' state.
+  std::mutex process_mutex_;
+  std::unique_ptr<VisualOdometry> vo_;
+  StreamMonitor monitor_;
   bool have_base_transform_ = false, looked_up_base_ = false;
   Eigen::Matrix3d R_base_camera_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t_base_camera_ = Eigen::Vector3d::Zero();
@@ -127,15 +151,21 @@ class VoNode {
   ros::Time last_pose_stamp_;
   Eigen::Vector3d last_centre_ = Eigen::Vector3d::Zero();
 
-  // Diagnostics.
+  // Diagnostics: written by both sides and read by diagnose(), under stats_mutex_.
+  std::mutex stats_mutex_;
   diagnostic_updater::Updater updater_;
   double min_frequency_ = 1.0, max_frequency_ = 100.0;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
   ros::Time last_raw_image_, last_synced_image_;
+  int unsynced_images_ = 0;  // images since the last synchronised frame
+  ros::Time last_processed_;
   VisualOdometryResult last_result_;
   std::string last_problem_;
-  int frames_ = 0, invalid_camera_info_ = 0, bad_images_ = 0, time_jumps_ = 0, failures_ = 0,
-      dropped_ = 0, bad_features_ = 0;
+  int frames_ = 0, invalid_camera_info_ = 0, bad_images_ = 0, failures_ = 0, dropped_ = 0,
+      bad_features_ = 0, camera_info_outages_ = 0;
+  bool camera_info_outage_ = false;
+  StreamCounters stream_counters_;
+  LatencyWindow latency_ms_;
   // Stereo frames whose scale fell back to mono_scale, and the last reason.
   int stereo_scale_fallbacks_ = 0;
   std::string last_scale_fallback_;

@@ -1,6 +1,8 @@
 // Strecha multi-view benchmark reader (see readers.h for the layout).
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -56,8 +58,10 @@ bool read_camera_file(const std::string& path, Frame* frame, std::string* error)
   if (!to_rotation(R, path, R_line, &frame->R_wc, error)) return false;
   frame->c_w = Eigen::Vector3d(v[21], v[22], v[23]);
   const double width = v[24], height = v[25];
-  if (!(width >= 1.0) || !(height >= 1.0) || width != static_cast<int>(width) ||
-      height != static_cast<int>(height))
+  // Range first: converting a double beyond an int is undefined behaviour.
+  constexpr double kMaxSide = std::numeric_limits<int>::max();
+  if (!(width >= 1.0) || !(height >= 1.0) || width > kMaxSide || height > kMaxSide ||
+      width != std::floor(width) || height != std::floor(height))
     return fail(error, located(path, size_line, "width and height must be positive integers"));
   frame->camera.pinhole.width = static_cast<int>(width);
   frame->camera.pinhole.height = static_cast<int>(height);

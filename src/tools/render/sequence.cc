@@ -52,6 +52,7 @@ std::string sequence_usage(const std::string& program) {
     << "into a bag: /camera/left/{image_raw,camera_info} (and /camera/right/... with --stereo),\n"
     << "/ground_truth/pose, /tf (world -> gt_camera_left_optical) and /tf_static.\n"
     << "  --frames N         frames (default 150)\n"
+    << "  --laps L           instead of --frames: L laps of the closed route (e.g. 1 for a loop)\n"
     << "  --stereo           also render the right camera\n"
     << "  --width W --height H  image size (default 640 x 480)\n"
     << "  --rate HZ          frame rate (default 10)\n"
@@ -81,7 +82,7 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     static const char* kValued[] = {"--out",           "--png-dir",    "--frames", "--width",
                                     "--height",        "--rate",       "--seed",   "--scene",
                                     "--baseline",      "--speed",      "--focal",  "--noise",
-                                    "--supersampling", "--compression"};
+                                    "--supersampling", "--compression", "--laps"};
     bool known = false;
     for (const char* name : kValued) known = known || arg == name;
     if (!known) return "unknown argument '" + arg + "'";
@@ -96,6 +97,8 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       ok = !v.empty();
     } else if (arg == "--frames") {
       ok = parse_int(v, 1, 100000, &o->frames);
+    } else if (arg == "--laps") {
+      ok = parse_double(v, 0.0, 100.0, true, &o->laps);
     } else if (arg == "--width") {
       ok = parse_int(v, 16, 4096, &o->width);
     } else if (arg == "--height") {
@@ -150,8 +153,16 @@ Sequence make_sequence(const SequenceOptions& options) {
   scene.type = options.scene;
   scene.seed = options.seed;
   seq.scene = build_scene(scene);
+  if (options.laps > 0.0) {
+    const double frames =
+        std::round(options.laps * route_length(seq.scene) / options.speed * options.rate);
+    if (!(frames >= 2.0 && frames <= 1e6))
+      throw std::invalid_argument("render sequence: --laps gives " + std::to_string(frames) +
+                                  " frames");
+    seq.options.frames = static_cast<int>(frames);
+  }
   PathOptions path;
-  path.num_frames = options.frames;
+  path.num_frames = seq.options.frames;
   path.rate_hz = options.rate;
   path.speed = options.speed;
   path.seed = options.seed;

@@ -20,6 +20,9 @@ struct SequenceOptions {
   std::string out_bag;  // required
   std::string png_dir;  // empty: no PNGs
   int frames = 150;
+  // > 0: the frame count is this many laps of the scene's closed route at `speed` and `rate`
+  // (rounded), replacing `frames`; one lap replayed in a loop makes an endless walk.
+  double laps = 0.0;
   bool stereo = false;
   int width = 640, height = 480;
   double rate = 10.0;  // Hz
