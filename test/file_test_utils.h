@@ -1,7 +1,8 @@
 #pragma once
 
 // Files for tests that write their own fixtures: a temporary folder removed afterwards, a file
-// writer, and a readable check that an error message names what it should.
+// writer, and a readable check that an error message names what it should; and where the shared
+// real data lives for the tests that read it (they skip when it is absent).
 
 #include <unistd.h>
 
@@ -45,6 +46,18 @@ inline void write_file(const std::filesystem::path& path, const std::string& con
 inline ::testing::AssertionResult contains(const std::string& text, const std::string& part) {
   if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
+}
+
+// The real data sets (../shared/data/README.md): $HYBRID_VO_DATA when set, else ../shared/data
+// beside the source tree (HYBRID_VO_SHARED_DATA, set by CMakeLists.txt). From a git worktree
+// elsewhere, set HYBRID_VO_DATA.
+inline std::filesystem::path shared_data_dir() {
+  if (const char* env = std::getenv("HYBRID_VO_DATA")) return env;
+#ifdef HYBRID_VO_SHARED_DATA
+  return std::filesystem::path(HYBRID_VO_SHARED_DATA).lexically_normal();
+#else
+  return {};
+#endif
 }
 
 }  // namespace testing

@@ -42,6 +42,7 @@ using testing::KittiFixture;
 using testing::LamarWriter;
 using testing::Rendered;
 using testing::RigSession;
+using testing::shared_data_dir;
 using testing::TempDir;
 using testing::write_file;
 
@@ -378,13 +379,8 @@ TEST(KittiToBag, Executable) {
   EXPECT_TRUE(contains(output, "--out OUT.bag is required"));
 }
 
-fs::path data_dir() {
-  if (const char* env = std::getenv("HYBRID_VO_DATA")) return env;
-  return (fs::path(__FILE__).parent_path() / ".." / ".." / "shared" / "data").lexically_normal();
-}
-
 TEST(KittiToBag, RealData) {
-  const fs::path sequence = data_dir() / "kitti_seq0x_51" / "sequences" / "seq0x";
+  const fs::path sequence = shared_data_dir() / "kitti_seq0x_51" / "sequences" / "seq0x";
   if (!fs::exists(sequence)) GTEST_SKIP() << sequence << " not present";
   TempDir dir("test_convert");
   KittiBagOptions options;
@@ -585,6 +581,13 @@ TEST(LamarToBag, BadInputFailsWithFileAndLineAndLeavesNoBag) {
        {},
        "sensors.txt:2: ",
        "camera model FOV has no camera_info equivalent"},
+      {"camera model the reader does not know",
+       [](RigSession* s) {
+         s->writer.sensors[2] = "cam_right, , camera, EQUIRECTANGULAR, 160, 96, 1, 2";
+       },
+       {},
+       "sensors.txt:3: ",
+       "unknown camera model 'EQUIRECTANGULAR'"},
       {"undecodable image",
        [](RigSession* s) {
          write_file(s->writer.dir / "raw_data/images/cam_right/200000.png", "not a png");
@@ -641,6 +644,62 @@ TEST(LamarToBag, Executable) {
   ASSERT_EQ(data.ground_truth.size(), 5u);
   EXPECT_EQ(data.ground_truth[0].header.stamp, ros::Time(5.0));
   EXPECT_EQ(run(tool + " --session x --out y --cameras ,", &output), 2);
+}
+
+// The real phone query frame (../shared/data/lamar_phone_query_1), through the executable as a
+// user runs it, against values read by hand from the session's files.
+TEST(LamarToBag, RealPhoneQueryFrame) {
+  const fs::path session = shared_data_dir() / "lamar_phone_query_1" / "sessions" /
+                           "ios_2022-01-12_16.32.48_000_14911412476";
+  if (!fs::exists(session)) GTEST_SKIP() << session << " not present";
+  TempDir dir("test_convert");
+  const fs::path bag = dir.path() / "phone.bag";
+  const std::string tool = std::string(HYBRID_VO_BIN_DIR) + "/hybrid_vo_lamar_to_bag";
+  // The stream is the sub-session's per-frame cameras without their timestamps; its topic name
+  // is that id made a valid ROS name, which is what lamar.launch camera:= takes.
+  const std::string stream = "ios_2022-01-12_16.32.48_000/cam_phone";
+  const std::string name = "ios_2022_01_12_16_32_48_000_cam_phone";
+  std::string output;
+  ASSERT_EQ(run(tool + " --session " + session.string() + " --out " + bag.string() +
+                    " --cameras " + stream,
+                &output),
+            0)
+      << output;
+  EXPECT_TRUE(contains(output, stream + ": 1 images on /camera/" + name + "/image_raw"));
+  EXPECT_TRUE(contains(output, "1 ground-truth poses of " + stream + " from " +
+                                   (session / "trajectories.txt").string() +
+                                   "; time offset 0 s"));
+  EXPECT_TRUE(contains(output, "camera:=" + name + "\n"));
+
+  const BagData data = read_bag(bag.string());
+  // 14911412476 us from the start of the recording, kept as they are (not below 1 s).
+  const ros::Time stamp(14911, 412476000);
+  const auto& images = data.images.at("/camera/" + name + "/image_raw");
+  ASSERT_EQ(images.size(), 1u);
+  EXPECT_EQ(images[0].header.stamp, stamp);
+  EXPECT_EQ(images[0].header.frame_id, "camera_" + name + "_optical");
+  EXPECT_EQ(mono8(images[0]).size(), cv::Size(1440, 1920));  // portrait
+
+  // sensors.txt: PINHOLE 1440 1920 fx fy 1590.657593, c (716.893005, 939.960144) - 0.5.
+  const auto& infos = data.infos.at("/camera/" + name + "/camera_info");
+  ASSERT_EQ(infos.size(), 1u);
+  EXPECT_EQ(infos[0].header.stamp, stamp);
+  const PinholeCamera camera(1590.657593, 1590.657593, 716.393005, 939.460144, 1440, 1920);
+  expect_intrinsics(infos[0], camera, 1e-9);
+  EXPECT_EQ(infos[0].distortion_model, "plumb_bob");
+  EXPECT_EQ(infos[0].D, std::vector<double>(5, 0.0));
+
+  // trajectories.txt: qw qx qy qz tx ty tz, camera-to-world; the bag writes qw >= 0.
+  ASSERT_EQ(data.ground_truth.size(), 1u);
+  const geometry_msgs::PoseStamped& gt = data.ground_truth[0];
+  EXPECT_EQ(gt.header.stamp, stamp);
+  EXPECT_NEAR(gt.pose.orientation.w, 0.13748284967929092, 1e-9);
+  EXPECT_NEAR(gt.pose.orientation.x, 0.3193805157658011, 1e-9);
+  EXPECT_NEAR(gt.pose.orientation.y, 0.39862177517258024, 1e-9);
+  EXPECT_NEAR(gt.pose.orientation.z, -0.848643171510555, 1e-9);
+  EXPECT_NEAR(gt.pose.position.x, -16.152784, 1e-9);
+  EXPECT_NEAR(gt.pose.position.y, 3.622267, 1e-9);
+  EXPECT_NEAR(gt.pose.position.z, 30.62104, 1e-9);
 }
 
 }  // namespace

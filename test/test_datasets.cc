@@ -36,6 +36,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::contains;
+using testing::shared_data_dir;
 using testing::TempDir;
 using testing::write_file;
 
@@ -943,18 +944,12 @@ TEST(PointSubset, ParsesSelectionNames) {
 // ------------------------------------------------------------------------------------------------
 // The real data sets, when present
 
-fs::path data_dir() {
-  if (const char* env = std::getenv("HYBRID_VO_DATA")) return env;
-  // This file is test/test_datasets.cc of the project, and the data lives at ../shared/data.
-  return (fs::path(__FILE__).parent_path() / ".." / ".." / "shared" / "data").lexically_normal();
-}
-
 double rotation_angle_deg(const Eigen::Matrix3d& R) {
   return std::acos(std::clamp((R.trace() - 1.0) / 2.0, -1.0, 1.0)) * 180.0 / M_PI;
 }
 
 TEST(RealData, Kitti) {
-  const fs::path path = data_dir() / "kitti_seq0x_51";
+  const fs::path path = shared_data_dir() / "kitti_seq0x_51";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not present";
   Sequence sequence;
   std::string error;
@@ -975,7 +970,7 @@ TEST(RealData, Kitti) {
 }
 
 TEST(RealData, Tum) {
-  const fs::path path = data_dir() / "tum_fr1_plant_19";
+  const fs::path path = shared_data_dir() / "tum_fr1_plant_19";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not present";
   Sequence sequence;
   std::string error;
@@ -996,7 +991,7 @@ TEST(RealData, Tum) {
 
 TEST(RealData, Strecha) {
   for (const char* scene : {"fountain-P11", "Herz-Jesus-P8"}) {
-    const fs::path path = data_dir() / "strecha_fountain_herzjesu" / scene;
+    const fs::path path = shared_data_dir() / "strecha_fountain_herzjesu" / scene;
     if (!fs::exists(path)) GTEST_SKIP() << path << " not present";
     Sequence sequence;
     std::string error;

@@ -1,6 +1,7 @@
 // The LaMAR Capture session reader (src/tools/datasets/lamar.h) on sessions written here as text:
 // pose directions and composition checked against hand-computed points, quaternion order, the
-// COLMAP principal point, camera models, phone streams, and every error with its file and line.
+// COLMAP principal point, camera models, phone streams, and every error with its file and line;
+// and on the real phone query frame of ../shared/data/lamar_phone_query_1 when it is present.
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -18,6 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::contains;
+using testing::shared_data_dir;
 using testing::TempDir;
 using testing::write_file;
 
@@ -315,6 +317,67 @@ TEST(Lamar, ReportsMissingFilesAndMalformedLines) {
   std::string error;
   EXPECT_FALSE(read_lamar_session("/nonexistent/session", &session, &error));
   EXPECT_TRUE(contains(error, "/nonexistent/session: no such directory"));
+}
+
+// The real session, checked against values read by hand from its files (MANIFEST.md there).
+TEST(Lamar, RealPhoneQueryFrame) {
+  const fs::path dir = shared_data_dir() / "lamar_phone_query_1" / "sessions" /
+                       "ios_2022-01-12_16.32.48_000_14911412476";
+  if (!fs::exists(dir)) GTEST_SKIP() << dir << " not present";
+  LamarSession session;
+  std::string error;
+  ASSERT_TRUE(read_lamar_session(dir.string(), &session, &error)) << error;
+
+  // sensors.txt: the camera of this frame, and a bluetooth sensor without parameters.
+  const std::string camera = "ios_2022-01-12_16.32.48_000/cam_phone_14911412476";
+  ASSERT_EQ(session.sensors.size(), 2u);
+  EXPECT_EQ(session.sensors[0].id, camera);
+  EXPECT_EQ(session.sensors[0].name, "phone camera for timestamp 14911412476");
+  EXPECT_EQ(session.sensors[1].id, "ios_2022-01-12_16.32.48_000/bt_sensor");
+  EXPECT_EQ(session.sensors[1].type, "bluetooth");
+  EXPECT_FALSE(session.sensors[1].is_camera());
+  EXPECT_TRUE(session.rigs.empty());  // no rigs.txt
+
+  // PINHOLE 1440 1920 1590.657593 1590.657593 716.893005 939.960144, principal point moved to
+  // pixel centres at integers.
+  const LamarSensor& sensor = session.sensors[0];
+  EXPECT_EQ(sensor.model, "PINHOLE");
+  EXPECT_TRUE(sensor.unsupported.empty()) << sensor.unsupported;
+  const CameraIntrinsics& c = sensor.intrinsics;
+  EXPECT_EQ(c.width, 1440);
+  EXPECT_EQ(c.height, 1920);
+  EXPECT_DOUBLE_EQ(c.fx, 1590.657593);
+  EXPECT_DOUBLE_EQ(c.fy, 1590.657593);
+  EXPECT_NEAR(c.cx, 716.393005, 1e-9);
+  EXPECT_NEAR(c.cy, 939.460144, 1e-9);
+  EXPECT_EQ(c.distortion_model, "plumb_bob");
+  EXPECT_EQ(c.D, std::vector<double>(5, 0.0));
+
+  // images.txt: microseconds since the start of the recording, the JPEG under raw_data/.
+  ASSERT_EQ(session.images.size(), 1u);
+  const LamarImage& image = session.images[0];
+  EXPECT_EQ(image.timestamp_us, 14911412476);
+  EXPECT_EQ(image.sensor_id, camera);
+  EXPECT_EQ(image.line, 2);
+  EXPECT_EQ(fs::path(image.path),
+            dir / "raw_data" / "ios_2022-01-12_16.32.48_000" /
+                "ios_2022-01-12_16.32.48_000_14911412476" / "14911412476.jpg");
+
+  // trajectories.txt: qw qx qy qz tx ty tz of the camera itself, camera-to-world.
+  EXPECT_EQ(session.poses_path, (dir / "trajectories.txt").string());
+  Eigen::Isometry3d T_world_camera;
+  ASSERT_TRUE(session.camera_pose(14911412476, camera, &T_world_camera));
+  const Eigen::Quaterniond q(-0.13748284967929092, -0.3193805157658011, -0.39862177517258024,
+                             0.848643171510555);
+  EXPECT_TRUE(T_world_camera.linear().isApprox(q.normalized().toRotationMatrix(), 1e-12));
+  EXPECT_TRUE(T_world_camera.translation().isApprox(
+      Eigen::Vector3d(-16.152784, 3.622267, 30.62104), 1e-12));
+
+  // One stream per phone: the sub-session's per-frame cameras without their timestamps.
+  const std::vector<LamarStream> streams = lamar_camera_streams(session);
+  ASSERT_EQ(streams.size(), 1u);
+  EXPECT_EQ(streams[0].id, "ios_2022-01-12_16.32.48_000/cam_phone");
+  EXPECT_EQ(streams[0].images, std::vector<size_t>{0});
 }
 
 }  // namespace

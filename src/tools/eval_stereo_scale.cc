@@ -204,13 +204,16 @@ int main(int argc, char** argv) {
   };
   // The node's default: the depth-limited fit with the self-calibrated disparity offset
   // (DisparityOffsetFilter, updated pair by pair as VisualOdometry does).
-  auto calibrated = [](double max_baselines) {
+  auto calibrated = [](double max_baselines, double offset_sigma = 0.0,
+                       double point_sigma_px = hybrid_vo::StereoScaleOptions().point_sigma_px) {
     auto filter = std::make_shared<hybrid_vo::DisparityOffsetFilter>();
     return [=](const Pair& p, double* sigma) {
       hybrid_vo::StereoScaleOptions o;
       filter->update(p.unit, p.rig, p.observations, o);
       o.max_depth_baselines = max_baselines;
       o.disparity_offset_px = filter->offset();
+      o.disparity_offset_sigma_px = offset_sigma;
+      o.point_sigma_px = point_sigma_px;
       const hybrid_vo::StereoScaleEstimate e =
           hybrid_vo::estimate_stereo_scale(p.unit, p.rig, p.observations, o);
       *sigma = e.sigma;
@@ -220,6 +223,14 @@ int main(int argc, char** argv) {
   const std::vector<Named> candidates = {
       {"default", calibrated(40.0)},
       {"calibrated", calibrated(0.0)},
+      // Softer than the hard limit: a farther one, or the offset left free in each pair's fit
+      // around the calibrated one with a prior sigma (px), which discounts the far points'
+      // scale information by how well the offset is known (README, "Stereo scale").
+      {"cal<60b", calibrated(60.0)},
+      {"cal+p0.1", calibrated(0.0, 0.1)},
+      {"cal+p0.2", calibrated(0.0, 0.2)},
+      {"cal<40b+p0.1", calibrated(40.0, 0.1)},
+      {"default,pt0.25", calibrated(40.0, 0.0, 0.25)},  // image points weighted twice as much
       {"median", [](const Pair& p, double*) { return hybrid_vo::median_of_point_scales(p.unit, p.rig, p.observations, 0.0); }},
       {"median<40b", [](const Pair& p, double*) { return hybrid_vo::median_of_point_scales(p.unit, p.rig, p.observations, 40.0); }},
       {"ml", ml(0.0)},
