@@ -370,19 +370,24 @@ class Player {
     const double duration = samples_t_.empty() ? 0.0 : samples_t_.back();
     std::lock_guard<std::mutex> lock(mutex_);
     const int answered = static_cast<int>(answers_.size());
-    const double p99 = quantile(steady_latencies_, 0.99);
+    // A run shorter than its warm-up (a fast node in lock-step) has no steady latencies: all
+    // answers count then, rather than reporting a latency of zero and an infinite rate.
+    std::vector<double> latencies = steady_latencies_;
+    if (latencies.empty())
+      for (const auto& answer : answers_) latencies.push_back(answer.second);
+    const double p99 = quantile(latencies, 0.99);
     // Fed at a rate: the latency in frame periods. In lock-step: the sustainable rate, at which
     // 95 % of the frames are done before the next one comes (each cycle is one latency).
     const std::string rate_field =
         o_.rate > 0 ? "latency_p99_periods=" + std::to_string(p99 * o_.rate / 1000.0)
                     : "sustainable_hz=" +
-                          std::to_string(1000.0 / std::max(1e-3, quantile(steady_latencies_, 0.95)));
+                          std::to_string(1000.0 / std::max(1e-3, quantile(latencies, 0.95)));
     std::printf(
         "summary: frames=%d dropped=%d rss_start_mb=%.1f rss_end_mb=%.1f "
         "rss_slope_mb_per_h=%.2f latency_p50_ms=%.1f latency_p99_ms=%.1f rate_hz=%.2f "
         "cpu_percent=%.1f ok=%d queue_drops=%d duration_s=%.0f warmup_s=%.0f load1=%.1f %s\n",
         sent_, sent_ - answered, rss.empty() ? 0.0 : rss.front(), rss.empty() ? 0.0 : rss.back(),
-        slope(t, rss), quantile(steady_latencies_, 0.5), p99,
+        slope(t, rss), quantile(latencies, 0.5), p99,
         duration > 0 ? answered / duration : 0.0, cpu_mean, ok_, queue_drops_, duration, warmup_s_,
         load_mean, rate_field.c_str());
     std::fflush(stdout);
