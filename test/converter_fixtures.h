@@ -15,7 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "file_test_utils.h"
-#include "render/sequence.h"
+#include "hybrid_vo/render/sequence.h"
 
 namespace hybrid_vo {
 namespace testing {

@@ -24,7 +24,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "hybrid_vo/geometry/camera.h"
-#include "render/camera_path.h"
+#include "hybrid_vo/render/camera_path.h"
 
 namespace hybrid_vo {
 namespace testing {

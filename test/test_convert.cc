@@ -1,4 +1,4 @@
-// The KITTI and LaMAR bag converters (src/tools/convert_*.h) on fixtures that this test writes
+// The KITTI and LaMAR bag converters (hybrid_vo/conversion) on fixtures that this test writes
 // from the synthetic renderer in each data set's own layout, read back with rosbag::View: images,
 // camera_info, stamps, ground truth and static transforms must round-trip. Broken inputs must
 // fail with the file and line and leave no bag behind. One test per converter runs the built
@@ -25,14 +25,14 @@
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "convert_kitti.h"
-#include "convert_lamar.h"
 #include "converter_fixtures.h"
 #include "file_test_utils.h"
-#include "render/sequence.h"
+#include "hybrid_vo/conversion/kitti_to_bag.h"
+#include "hybrid_vo/conversion/lamar_to_bag.h"
+#include "hybrid_vo/render/sequence.h"
 
 namespace hybrid_vo {
-namespace tools {
+namespace conversion {
 namespace {
 
 namespace fs = std::filesystem;
@@ -703,5 +703,5 @@ TEST(LamarToBag, RealPhoneQueryFrame) {
 }
 
 }  // namespace
-}  // namespace tools
+}  // namespace conversion
 }  // namespace hybrid_vo

@@ -1,4 +1,4 @@
-// The data set readers (src/tools/datasets) on fixtures written here into a temporary folder, so
+// The data set readers (hybrid_vo/datasets) on fixtures written here into a temporary folder, so
 // that every convention (camera-to-world poses, quaternion order, K from P0, the SuperGlue line
 // layout) and every error path is checked without the real data. The RealData tests run on
 // ../shared/data when it exists (or $HYBRID_VO_DATA) and skip otherwise.
@@ -23,11 +23,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "datasets/point_subset.h"
-#include "datasets/readers.h"
-#include "datasets/sequence.h"
-#include "datasets/text_file.h"
 #include "file_test_utils.h"
+#include "hybrid_vo/datasets/point_subset.h"
+#include "hybrid_vo/datasets/readers.h"
+#include "hybrid_vo/datasets/sequence.h"
+#include "hybrid_vo/datasets/text_file.h"
 #include "hybrid_vo/geometry/rotation.h"
 
 namespace hybrid_vo {

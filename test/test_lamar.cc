@@ -1,4 +1,4 @@
-// The LaMAR Capture session reader (src/tools/datasets/lamar.h) on sessions written here as text:
+// The LaMAR Capture session reader (hybrid_vo/datasets/lamar.h) on sessions written here as text:
 // pose directions and composition checked against hand-computed points, quaternion order, the
 // COLMAP principal point, camera models, phone streams, and every error with its file and line;
 // and on the real phone query frame of ../shared/data/lamar_phone_query_1 when it is present.
@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "datasets/lamar.h"
 #include "file_test_utils.h"
+#include "hybrid_vo/datasets/lamar.h"
 
 namespace hybrid_vo {
 namespace datasets {

@@ -24,8 +24,8 @@
 #include <tf2_ros/transform_listener.h>
 
 #include "hybrid_vo/geometry/pose_error.h"
+#include "hybrid_vo/render/sequence.h"
 #include "node_test_utils.h"
-#include "render/sequence.h"
 
 namespace hybrid_vo {
 namespace {

@@ -16,7 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "render/sequence.h"
+#include "hybrid_vo/render/sequence.h"
 
 namespace {
 

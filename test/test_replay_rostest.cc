@@ -20,9 +20,9 @@
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "convert_kitti.h"
-#include "convert_lamar.h"
 #include "converter_fixtures.h"
+#include "hybrid_vo/conversion/kitti_to_bag.h"
+#include "hybrid_vo/conversion/lamar_to_bag.h"
 #include "hybrid_vo/geometry/pose_error.h"
 
 namespace hybrid_vo {
@@ -157,11 +157,11 @@ TEST(KittiReplay, ConvertedSequenceThroughKittiLaunch) {
   testing::TempDir dir("kitti_replay");
   testing::KittiFixture fixture(dir.path(), rendering());
   fixture.write();
-  tools::KittiBagOptions options;
+  conversion::KittiBagOptions options;
   options.sequence_dir = fixture.sequence_dir().string();
   options.out_bag = (dir.path() / "kitti.bag").string();
   std::string error;
-  ASSERT_TRUE(tools::convert_kitti(options, &error)) << error;
+  ASSERT_TRUE(conversion::convert_kitti(options, &error)) << error;
   Replay replay(options.out_bag, "/camera/left");
   ASSERT_TRUE(replay.run());
   replay.check(1.0, 10.0);
@@ -171,11 +171,11 @@ TEST(LamarReplay, ConvertedRigSessionThroughLamarLaunch) {
   testing::TempDir dir("lamar_replay");
   testing::RigSession session(dir.path() / "session", rendering());
   session.writer.write();
-  tools::LamarBagOptions options;
+  conversion::LamarBagOptions options;
   options.session_dir = session.writer.dir.string();
   options.out_bag = (dir.path() / "lamar.bag").string();
   std::string error;
-  ASSERT_TRUE(tools::convert_lamar(options, &error)) << error;
+  ASSERT_TRUE(conversion::convert_lamar(options, &error)) << error;
   Replay replay(options.out_bag, "/camera/cam_left");  // lamar_replay.test: camera:=cam_left
   ASSERT_TRUE(replay.run());
   replay.check(1.0, 10.0);

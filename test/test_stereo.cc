@@ -13,7 +13,7 @@
 #include "hybrid_vo/frontend/stereo.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/rotation.h"
-#include "render/sequence.h"
+#include "hybrid_vo/render/sequence.h"
 
 namespace {
 using namespace hybrid_vo;

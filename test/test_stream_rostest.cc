@@ -13,8 +13,8 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include "hybrid_vo/render/sequence.h"
 #include "node_test_utils.h"
-#include "render/sequence.h"
 
 namespace hybrid_vo {
 namespace {

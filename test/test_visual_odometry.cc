@@ -13,7 +13,7 @@
 #include "hybrid_vo/frontend/line_tracker.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/frontend/worker_thread.h"
-#include "render/sequence.h"
+#include "hybrid_vo/render/sequence.h"
 
 namespace {
 

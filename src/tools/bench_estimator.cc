@@ -13,10 +13,10 @@
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
+#include "hybrid_vo/evaluation/opencv_baseline.h"
+#include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/synthetic/manhattan_scene.h"
-#include "opencv_baseline.h"
-#include "statistics.h"
 
 namespace hybrid_vo {
 namespace {
@@ -83,7 +83,7 @@ bool parse(int argc, char** argv, Arguments* a) {
   return true;
 }
 
-using hybrid_vo::tools::median;
+using hybrid_vo::evaluation::median;
 
 struct Samples {
   std::vector<double> ms, iterations, rot, trans, recall;
@@ -108,7 +108,7 @@ double recall(const std::vector<char>& estimated, const std::vector<bool>& truth
 // measured on MAGSAC's own inliers.
 void run_opencv(const ManhattanScene& scene, double threshold_px, Samples* out) {
   const auto start = std::chrono::steady_clock::now();
-  const tools::OpenCvPose result = tools::opencv_usac_magsac(
+  const evaluation::OpenCvPose result = evaluation::opencv_usac_magsac(
       scene.matches.points, scene.camera1, scene.camera2, threshold_px, 0);
   out->ms.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());

@@ -15,14 +15,14 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "datasets/kitti.h"
+#include "hybrid_vo/datasets/kitti.h"
+#include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
-#include "statistics.h"
 
 namespace hybrid_vo {
 namespace {
 
-using tools::median;
+using evaluation::median;
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program

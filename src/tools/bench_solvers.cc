@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "hybrid_vo/estimation/refine_relative_pose.h"
+#include "hybrid_vo/evaluation/plot.h"
+#include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/geometry/essential.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
 #include "hybrid_vo/synthetic/minimal_instances.h"
-#include "plot.h"
-#include "statistics.h"
 
 #ifdef HYBRID_VO_HAVE_OPENGV
 #include <opengv/relative_pose/CentralRelativeAdapter.hpp>
@@ -100,7 +100,7 @@ bool parse(int argc, char** argv, Arguments* args) {
   return true;
 }
 
-using hybrid_vo::tools::median;
+using hybrid_vo::evaluation::median;
 
 struct Row {
   SolverId id = SolverId::k5pt;
@@ -231,14 +231,14 @@ bool write_histograms(const std::string& dir, const std::vector<Row>& rows) {
   std::ofstream csv(dir + "/stability_histograms.csv");
   if (!csv) return false;
   csv << "config,solver,error,bin_lo,bin_hi,count\n";
-  std::vector<tools::PlotSeries> rot_series, trans_series;
+  std::vector<evaluation::PlotSeries> rot_series, trans_series;
   for (const Row& r : rows) {
     if (r.signs_known) continue;
     for (int kind = 0; kind < 2; ++kind) {
       const std::vector<double>& values = kind == 0 ? r.log_rot : r.log_trans;
       std::vector<int> counts(bins, 0);
       for (double v : values) counts[std::clamp(static_cast<int>((v - lo) / width), 0, bins - 1)]++;
-      tools::PlotSeries s;
+      evaluation::PlotSeries s;
       s.label = ascii_code(solver_info(r.id));
       for (int b = 0; b < bins; ++b) {
         csv << r.config << ',' << r.solver << ',' << (kind == 0 ? "rotation" : "translation") << ','
@@ -250,13 +250,13 @@ bool write_histograms(const std::string& dir, const std::vector<Row>& rows) {
       if (r.mean_solutions > 0.0) (kind == 0 ? rot_series : trans_series).push_back(s);
     }
   }
-  tools::PlotOptions options;
+  evaluation::PlotOptions options;
   options.x_label = "log10 error [rad]";
   options.y_label = "fraction of instances";
   options.title = "Rotation error of the minimal solvers (noiseless, best solution)";
-  bool ok = tools::write_line_plot(dir + "/stability_rotation.png", rot_series, options);
+  bool ok = evaluation::write_line_plot(dir + "/stability_rotation.png", rot_series, options);
   options.title = "Translation error of the minimal solvers (noiseless, best solution)";
-  ok = tools::write_line_plot(dir + "/stability_translation.png", trans_series, options) && ok;
+  ok &= evaluation::write_line_plot(dir + "/stability_translation.png", trans_series, options);
   return ok;
 }
 
@@ -268,10 +268,10 @@ bool write_noise_curve(const std::string& dir, int instances, uint64_t seed) {
   std::ofstream csv(dir + "/noise_curve.csv");
   if (!csv) return false;
   csv << "config,noise_px,median_rot_deg,median_trans_deg,median_rot_lo_deg,median_trans_lo_deg\n";
-  std::vector<tools::PlotSeries> raw, refined;
+  std::vector<evaluation::PlotSeries> raw, refined;
   for (const SolverInfo& info : solver_table()) {
     if (!info.well_posed) continue;
-    tools::PlotSeries s_raw{ascii_code(info), {}, {}}, s_lo{ascii_code(info), {}, {}};
+    evaluation::PlotSeries s_raw{ascii_code(info), {}, {}}, s_lo{ascii_code(info), {}, {}};
     for (double px : levels_px) {
       MinimalInstanceOptions options;
       options.noise = px / 1000.0;
@@ -323,13 +323,13 @@ bool write_noise_curve(const std::string& dir, int instances, uint64_t seed) {
     raw.push_back(s_raw);
     refined.push_back(s_lo);
   }
-  tools::PlotOptions options;
+  evaluation::PlotOptions options;
   options.x_label = "noise [px at f = 1000]";
   options.y_label = "median max(rot, trans) error [deg]";
   options.title = "Minimal solvers under noise (best solution, no refinement)";
-  bool ok = tools::write_line_plot(dir + "/noise_raw.png", raw, options);
+  bool ok = evaluation::write_line_plot(dir + "/noise_raw.png", raw, options);
   options.title = "Minimal solvers under noise, then local optimisation on 50 points";
-  ok = tools::write_line_plot(dir + "/noise_lo.png", refined, options) && ok;
+  ok = evaluation::write_line_plot(dir + "/noise_lo.png", refined, options) && ok;
   return ok;
 }
 

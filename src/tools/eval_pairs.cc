@@ -13,14 +13,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "datasets/point_subset.h"
-#include "datasets/readers.h"
+#include "hybrid_vo/datasets/point_subset.h"
+#include "hybrid_vo/datasets/readers.h"
+#include "hybrid_vo/evaluation/command_line.h"
+#include "hybrid_vo/evaluation/opencv_baseline.h"
+#include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/lines/two_view.h"
-#include "opencv_baseline.h"
-#include "tool_args.h"
-#include "statistics.h"
 
 namespace hybrid_vo {
 namespace {
@@ -110,7 +110,7 @@ bool parse(int argc, char** argv, Arguments* a) {
     } else if (arg == "--presets") {
       a->presets.clear();
       a->opencv = false;
-      for (const std::string& p : tools::split_list(v)) {
+      for (const std::string& p : evaluation::split_list(v)) {
         RelativePoseEstimatorOptions unused;
         if (p == "opencv_usac_magsac") a->opencv = true;
         else if (preset_options(p, &unused)) a->presets.push_back(p);
@@ -136,7 +136,7 @@ bool parse(int argc, char** argv, Arguments* a) {
         return std::cerr << "error: --point-threshold must be > 0\n", false;
     } else if (arg == "--max-points") {
       a->max_points.clear();
-      for (const std::string& item : tools::split_list(v)) {
+      for (const std::string& item : evaluation::split_list(v)) {
         if (item == "all") {
           a->max_points.push_back(-1);
           continue;
@@ -149,7 +149,7 @@ bool parse(int argc, char** argv, Arguments* a) {
       if (a->max_points.empty()) return std::cerr << "error: --max-points needs a value\n", false;
     } else if (arg == "--point-selection") {
       a->selections.clear();
-      for (const std::string& item : tools::split_list(v)) {
+      for (const std::string& item : evaluation::split_list(v)) {
         datasets::PointSelection selection;
         if (!datasets::parse_point_selection(item, &selection))
           return std::cerr << "error: --point-selection must be random or clustered\n", false;
@@ -172,7 +172,7 @@ bool parse(int argc, char** argv, Arguments* a) {
   return true;
 }
 
-using hybrid_vo::tools::median;
+using hybrid_vo::evaluation::median;
 
 struct MethodStats {
   std::vector<double> errors, estimator_ms;
@@ -233,7 +233,8 @@ class FeatureCache {
 bool run_opencv(const TwoViewMatches& m, const PinholeCamera& c1, const PinholeCamera& c2,
                 double threshold_px, uint64_t seed, double* ms, RelativePose* pose) {
   const auto start = std::chrono::steady_clock::now();
-  const tools::OpenCvPose result = tools::opencv_usac_magsac(m.points, c1, c2, threshold_px, seed);
+  const evaluation::OpenCvPose result =
+      evaluation::opencv_usac_magsac(m.points, c1, c2, threshold_px, seed);
   *ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (result.ok) *pose = result.pose;
   return result.ok;

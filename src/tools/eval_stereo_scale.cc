@@ -24,18 +24,19 @@
 #include <sensor_msgs/Image.h>
 
 #include "hybrid_vo/estimation/stereo_scale.h"
+#include "hybrid_vo/evaluation/command_line.h"
+#include "hybrid_vo/evaluation/statistics.h"
+#include "hybrid_vo/evaluation/trajectory.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/node/conversions.h"
-#include "statistics.h"
-#include "tool_args.h"
-#include "trajectory.h"
 
 namespace {
 
 using hybrid_vo::StereoScaleObservation;
-using hybrid_vo::tools::StampedPose;
-using hybrid_vo::tools::Trajectory;
+namespace evaluation = hybrid_vo::evaluation;
+using evaluation::StampedPose;
+using evaluation::Trajectory;
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
@@ -117,7 +118,7 @@ int main(int argc, char** argv) {
   int max_features = 1000, max_frames = 1 << 30;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    auto next = [&] { return hybrid_vo::tools::option_value(argc, argv, &i); };
+    auto next = [&] { return evaluation::option_value(argc, argv, &i); };
     if (a == "--bag") bag = next();
     else if (a == "--preset") preset = next();
     else if (a == "--max-features") max_features = std::stoi(next());
@@ -180,8 +181,8 @@ int main(int argc, char** argv) {
     p.rig = {input.camera.pinhole.fx, input.camera.pinhole.fy, input.baseline_m};
     p.observations = r.scale_observations;
     StampedPose a, b;
-    if (hybrid_vo::tools::pose_at(gt, p.stamp_ref, 1e-3, &a) &&
-        hybrid_vo::tools::pose_at(gt, p.stamp, 1e-3, &b))
+    if (evaluation::pose_at(gt, p.stamp_ref, 1e-3, &a) &&
+        evaluation::pose_at(gt, p.stamp, 1e-3, &b))
       p.true_length = (b.c - a.c).norm();
     pairs.push_back(std::move(p));
   }
@@ -271,7 +272,7 @@ int main(int argc, char** argv) {
     std::printf("\n");
   }
   std::printf("# %zu frames, %zu pairs estimated; VisualOdometry median %.1f ms per frame\n",
-              frames.size(), pairs.size(), hybrid_vo::tools::median(total_ms));
+              frames.size(), pairs.size(), evaluation::median(total_ms));
   for (size_t k = 0; k < candidates.size(); ++k) {
     Trajectory t;
     for (const auto& [stamp, c] : centres[k]) {
@@ -281,14 +282,15 @@ int main(int argc, char** argv) {
       sp.c = c;
       t.push_back(sp);
     }
-    const hybrid_vo::tools::TrajectoryErrors te =
-        hybrid_vo::tools::compare_trajectories(t, gt, false, 1e-3);
+    const evaluation::TrajectoryErrors te =
+        evaluation::compare_trajectories(t, gt, false, 1e-3);
     double within = 0.0;
     for (double v : z[k]) within += v <= 1.0;
     std::printf("%-12s ratio median %.4f (p10 %.4f, p90 %.4f) over %zu pairs; drift %.2f %% "
                 "%.3f deg/100 m; ATE %.4f m",
-                candidates[k].name.c_str(), hybrid_vo::tools::median(ratios[k]),
-                hybrid_vo::tools::percentile(ratios[k], 0.1), hybrid_vo::tools::percentile(ratios[k], 0.9), ratios[k].size(),
+                candidates[k].name.c_str(), evaluation::median(ratios[k]),
+                evaluation::percentile(ratios[k], 0.1), evaluation::percentile(ratios[k], 0.9),
+                ratios[k].size(),
                 te.drift_trans_percent, te.drift_rot_deg_per_100m, te.ate);
     if (!z[k].empty())
       std::printf("; |error| <= sigma in %.0f %% of pairs", 100.0 * within / z[k].size());

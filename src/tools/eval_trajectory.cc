@@ -15,15 +15,16 @@
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "hybrid_vo/evaluation/plot.h"
+#include "hybrid_vo/evaluation/statistics.h"
+#include "hybrid_vo/evaluation/trajectory.h"
 #include "hybrid_vo/geometry/pose_error.h"
-#include "plot.h"
-#include "trajectory.h"
-#include "statistics.h"
 
 namespace {
 
-using hybrid_vo::tools::StampedPose;
-using hybrid_vo::tools::Trajectory;
+namespace evaluation = hybrid_vo::evaluation;
+using evaluation::StampedPose;
+using evaluation::Trajectory;
 constexpr double kDeg = 180.0 / M_PI;
 
 void usage(const char* program) {
@@ -35,7 +36,7 @@ void usage(const char* program) {
                "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n";
 }
 
-using hybrid_vo::tools::median;
+using evaluation::median;
 
 StampedPose from_transform(double stamp, const geometry_msgs::Transform& t) {
   StampedPose p;
@@ -166,8 +167,8 @@ int main(int argc, char** argv) {
   Trajectory gt;
   std::string error;
   if (!tum_est.empty()) {
-    if (!hybrid_vo::tools::read_tum_trajectory(tum_est, &run.trajectory, &error) ||
-        !hybrid_vo::tools::read_tum_trajectory(tum_gt, &gt, &error)) {
+    if (!evaluation::read_tum_trajectory(tum_est, &run.trajectory, &error) ||
+        !evaluation::read_tum_trajectory(tum_gt, &gt, &error)) {
       std::cerr << "error: " << error << "\n";
       return 1;
     }
@@ -196,8 +197,8 @@ int main(int argc, char** argv) {
         continue;
       }
       StampedPose a, b;
-      if (!hybrid_vo::tools::pose_at(gt, m.reference_stamp.toSec(), tolerance, &a) ||
-          !hybrid_vo::tools::pose_at(gt, m.header.stamp.toSec(), tolerance, &b))
+      if (!evaluation::pose_at(gt, m.reference_stamp.toSec(), tolerance, &a) ||
+          !evaluation::pose_at(gt, m.header.stamp.toSec(), tolerance, &b))
         continue;
       double rot = 180.0, dir = 180.0, ratio = NAN;
       if (m.status == hybrid_vo::MotionEstimate::STATUS_OK) {
@@ -225,8 +226,8 @@ int main(int argc, char** argv) {
   }
   const bool with_scale = run.scale_known * 2 < static_cast<int>(run.motions.size()) || run.motions.empty();
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> aligned;
-  const hybrid_vo::tools::TrajectoryErrors te =
-      hybrid_vo::tools::compare_trajectories(run.trajectory, gt, with_scale, tolerance, &aligned);
+  const evaluation::TrajectoryErrors te =
+      evaluation::compare_trajectories(run.trajectory, gt, with_scale, tolerance, &aligned);
   if (run.motions.empty()) {
     for (size_t i = 0; i < te.rot_err_deg.size(); ++i) {
       errors.push_back(std::max(te.rot_err_deg[i], te.dir_err_deg[i]));
@@ -242,18 +243,18 @@ int main(int argc, char** argv) {
     if (extent(2) > extent(a0) && extent(2) > extent(a1)) (extent(0) < extent(1) ? a0 : a1) = 2;
     else if (extent(2) > std::min(extent(0), extent(1))) (extent(0) < extent(1) ? a0 : a1) = 2;
     if (a0 > a1) std::swap(a0, a1);
-    hybrid_vo::tools::PlotSeries est{"estimate (aligned)", {}, {}}, truth{"ground truth", {}, {}};
+    evaluation::PlotSeries est{"estimate (aligned)", {}, {}}, truth{"ground truth", {}, {}};
     for (const auto& p : aligned) {
       est.x.push_back(p.first(a0));
       est.y.push_back(p.first(a1));
       truth.x.push_back(p.second(a0));
       truth.y.push_back(p.second(a1));
     }
-    hybrid_vo::tools::PlotOptions options;
+    evaluation::PlotOptions options;
     options.title = "Trajectory, top view";
     options.x_label = std::string("axis ") + "xyz"[a0] + " [m]";
     options.y_label = std::string("axis ") + "xyz"[a1] + " [m]";
-    if (!hybrid_vo::tools::write_line_plot(plot, {truth, est}, options))
+    if (!evaluation::write_line_plot(plot, {truth, est}, options))
       std::cerr << "warning: cannot write " << plot << "\n";
   }
   std::printf("# %d failed, %d skipped frames; trajectory: %d poses compared, scale %s %.4f; "
@@ -263,8 +264,8 @@ int main(int argc, char** argv) {
   if (!scale_ratios.empty())
     std::printf("# scale ratio (estimated / true translation length): median %.4f (p10 %.4f, "
                 "p90 %.4f) over %zu metric pairs\n",
-                median(scale_ratios), hybrid_vo::tools::percentile(scale_ratios, 0.1),
-                hybrid_vo::tools::percentile(scale_ratios, 0.9), scale_ratios.size());
+                median(scale_ratios), evaluation::percentile(scale_ratios, 0.1),
+                evaluation::percentile(scale_ratios, 0.9), scale_ratios.size());
   // Processing time per frame as the node measured it (MotionEstimate), skipped frames included:
   // what bounds the frame rate through the node. Then where it goes, stage by stage (the stages
   // overlap: the segments and the stereo matching run on a second thread), and the matches.

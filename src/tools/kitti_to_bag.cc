@@ -1,13 +1,13 @@
-// hybrid_vo_kitti_to_bag: a KITTI odometry sequence to a bag (convert_kitti.h).
+// hybrid_vo_kitti_to_bag: a KITTI odometry sequence to a bag (conversion/kitti_to_bag.h).
 #include <cstdio>
 #include <iostream>
 #include <string>
 #include <vector>
 
-#include "convert_kitti.h"
+#include "hybrid_vo/conversion/kitti_to_bag.h"
 
 int main(int argc, char** argv) {
-  using namespace hybrid_vo::tools;
+  using namespace hybrid_vo::conversion;
   const std::string program = argc > 0 ? argv[0] : "hybrid_vo_kitti_to_bag";
   KittiBagOptions options;
   const std::string usage_error =

@@ -1,13 +1,13 @@
-// hybrid_vo_lamar_to_bag: a LaMAR Capture session to a bag (convert_lamar.h).
+// hybrid_vo_lamar_to_bag: a LaMAR Capture session to a bag (conversion/lamar_to_bag.h).
 #include <cstdio>
 #include <iostream>
 #include <string>
 #include <vector>
 
-#include "convert_lamar.h"
+#include "hybrid_vo/conversion/lamar_to_bag.h"
 
 int main(int argc, char** argv) {
-  using namespace hybrid_vo::tools;
+  using namespace hybrid_vo::conversion;
   const std::string program = argc > 0 ? argv[0] : "hybrid_vo_lamar_to_bag";
   LamarBagOptions options;
   const std::string usage_error =

@@ -5,10 +5,10 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "hybrid_vo/evaluation/command_line.h"
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/visualization.h"
 #include "hybrid_vo/lines/two_view.h"
-#include "tool_args.h"
 
 namespace {
 
@@ -59,9 +59,9 @@ int main(int argc, char** argv) {
   if (positional.size() != 2 || camera_text.empty()) return usage(argv[0]), 2;
   CameraModel camera1, camera2;
   std::string error;
-  if (!tools::parse_camera(camera_text, &camera1, &error)) return fail(error, 2);
+  if (!evaluation::parse_camera(camera_text, &camera1, &error)) return fail(error, 2);
   camera2 = camera1;
-  if (!camera2_text.empty() && !tools::parse_camera(camera2_text, &camera2, &error))
+  if (!camera2_text.empty() && !evaluation::parse_camera(camera2_text, &camera2, &error))
     return fail(error, 2);
   TwoViewOptions options;
   if (!preset_options(preset, &options.estimator)) return fail("unknown preset '" + preset + "'", 2);

@@ -12,12 +12,12 @@
 #include <rosbag/exceptions.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "bag_writing.h"
-#include "render/sequence.h"
+#include "hybrid_vo/conversion/bag_writing.h"
+#include "hybrid_vo/render/sequence.h"
 
 namespace {
 
-using hybrid_vo::tools::BagOutput;
+using hybrid_vo::conversion::BagOutput;
 using namespace hybrid_vo::render;
 
 ros::Time stamp_of(int frame, double rate) {
@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
   try {
     const auto t_start = std::chrono::steady_clock::now();
     const Sequence seq = make_sequence(options);
-    namespace tools = hybrid_vo::tools;
+    namespace conversion = hybrid_vo::conversion;
     const rosbag::compression::CompressionType compression =
         options.compression == "lz4"   ? rosbag::compression::LZ4
         : options.compression == "bz2" ? rosbag::compression::BZ2
@@ -69,17 +69,19 @@ int main(int argc, char** argv) {
       std::cerr << "error: cannot write the bag: " << bag_error << "\n";
       return 1;
     }
-    const std::string left = tools::optical_frame("left"), right = tools::optical_frame("right");
+    const std::string left = conversion::optical_frame("left");
+    const std::string right = conversion::optical_frame("right");
 
     const ros::Time t0 = stamp_of(0, options.rate);
-    std::vector<geometry_msgs::TransformStamped> statics = {tools::stamped(
-        tools::kBaseFrame, left, t0,
-        tools::to_transform(base_from_optical(), Eigen::Vector3d::Zero()))};
+    std::vector<geometry_msgs::TransformStamped> statics = {conversion::stamped(
+        conversion::kBaseFrame, left, t0,
+        conversion::to_transform(base_from_optical(), Eigen::Vector3d::Zero()))};
     if (options.stereo) {
       const Eigen::Vector3d right_in_base =
           base_from_optical() * Eigen::Vector3d(options.baseline, 0.0, 0.0);
-      statics.push_back(tools::stamped(tools::kBaseFrame, right, t0,
-                                       tools::to_transform(base_from_optical(), right_in_base)));
+      statics.push_back(
+          conversion::stamped(conversion::kBaseFrame, right, t0,
+                              conversion::to_transform(base_from_optical(), right_in_base)));
     }
     out.write_tf_static(t0, statics, "/hybrid_vo_render_sequence");
 
@@ -93,11 +95,12 @@ int main(int argc, char** argv) {
         const RenderedView view = render_frame(seq, i, is_right);
         render_seconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-        const std::string prefix = tools::camera_topic(is_right ? "right" : "left");
+        const std::string prefix = conversion::camera_topic(is_right ? "right" : "left");
         const std::string& frame = is_right ? right : left;
         out.write_image(prefix + "/image_raw", frame, t, view.image);
-        out.bag().write(prefix + "/camera_info", t,
-                        tools::make_camera_info(seq.camera, frame, t, is_right ? tx_right : 0.0));
+        out.bag().write(
+            prefix + "/camera_info", t,
+            conversion::make_camera_info(seq.camera, frame, t, is_right ? tx_right : 0.0));
         if (!options.png_dir.empty()) {
           char name[64];
           std::snprintf(name, sizeof(name), "%s_%06d.png", is_right ? "right" : "left", i);
@@ -109,7 +112,7 @@ int main(int argc, char** argv) {
         }
       }
       const CameraPose& pose = seq.trajectory.poses[i];
-      out.write_ground_truth(tools::ground_truth_frame(left), t, pose.R_world_from_camera,
+      out.write_ground_truth(conversion::ground_truth_frame(left), t, pose.R_world_from_camera,
                              pose.centre);
     }
     if (!out.commit(&bag_error)) {

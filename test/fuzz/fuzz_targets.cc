@@ -20,9 +20,9 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud.h>
 
-#include "datasets/kitti.h"
-#include "datasets/lamar.h"
-#include "datasets/readers.h"
+#include "hybrid_vo/datasets/kitti.h"
+#include "hybrid_vo/datasets/lamar.h"
+#include "hybrid_vo/datasets/readers.h"
 #include "hybrid_vo/node/conversions.h"
 
 namespace hybrid_vo {

@@ -1,0 +1,63 @@
+#pragma once
+
+// The camera's walk through a render::Scene: along the scene's route with rounded 90-degree
+// turns, looking where it goes, with a walker's bob and sway. Poses are camera-to-world.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "hybrid_vo/render/scene.h"
+
+namespace hybrid_vo {
+namespace render {
+
+// A camera pose in the world: X_world = R_world_from_camera * X_camera + centre, with the camera
+// frame optical (x right, y down, z forward).
+struct CameraPose {
+  Eigen::Matrix3d R_world_from_camera = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d to_camera(const Eigen::Vector3d& X_world) const {
+    return R_world_from_camera.transpose() * (X_world - centre);
+  }
+  Eigen::Vector3d to_world(const Eigen::Vector3d& X_camera) const {
+    return R_world_from_camera * X_camera + centre;
+  }
+};
+
+// Columns: the optical frame's axes (x right, y down, z forward) in REP 103 body coordinates
+// (x forward, y left, z up).
+Eigen::Matrix3d base_from_optical();
+
+// The right camera of a rectified stereo pair: same rotation, centre `baseline` metres along
+// the left camera's x axis.
+CameraPose stereo_right(const CameraPose& left, double baseline);
+
+struct PathOptions {
+  int num_frames = 150;
+  double rate_hz = 10.0;
+  double speed = 1.5;  // metres per second along the route
+  double start = 0.0;  // metres along the route at frame 0 (the route is a closed loop)
+  double camera_height = 1.45;
+  double pitch_down_deg = 4.0;
+  bool sway = true;   // walking bob, sideways sway, small pitch, roll and yaw wobble
+  uint64_t seed = 1;  // phases of the sway
+};
+
+struct Trajectory {
+  std::vector<CameraPose> poses;  // per frame; the left camera for stereo
+  std::vector<double> times;      // seconds since frame 0: i / rate
+  double length = 0.0;            // metres travelled by the camera centre
+  double total_turn_deg = 0.0;    // sum of |heading change| between frames (without the wobble)
+};
+
+// Throws std::invalid_argument for invalid options.
+Trajectory make_trajectory(const Scene& scene, const PathOptions& options = {});
+
+// Length of the scene's route (one lap), metres.
+double route_length(const Scene& scene);
+
+}  // namespace render
+}  // namespace hybrid_vo

@@ -1,0 +1,69 @@
+#pragma once
+
+// A rendered sequence without ROS: the options of hybrid_vo_render_sequence and their parsing,
+// the scene, trajectory and camera they define, and per-frame rendering. The executable adds
+// the bag writing.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hybrid_vo/geometry/camera.h"
+#include "hybrid_vo/render/camera_path.h"
+#include "hybrid_vo/render/renderer.h"
+#include "hybrid_vo/render/scene.h"
+
+namespace hybrid_vo {
+namespace render {
+
+struct SequenceOptions {
+  std::string out_bag;  // required
+  std::string png_dir;  // empty: no PNGs
+  int frames = 150;
+  // > 0: the frame count is this many laps of the scene's closed route at `speed` and `rate`
+  // (rounded), replacing `frames`; one lap replayed in a loop makes an endless walk.
+  double laps = 0.0;
+  bool stereo = false;
+  int width = 640, height = 480;
+  double rate = 10.0;  // Hz
+  uint64_t seed = 1;   // scene, sway and noise
+  SceneType scene = SceneType::kCorridor;
+  double baseline = 0.12;  // metres, stereo only
+  double speed = 1.5;      // metres per second
+  double focal = 0.0;      // pixels; 0: 0.72 * width
+  double noise = 1.0;      // grey levels
+  int supersampling = 3;
+  std::string compression = "lz4";  // none, lz4 or bz2
+  bool help = false;
+};
+
+// Parses the arguments after the program name. Returns an empty string on success, else a
+// message naming the offending argument. --help sets `help` and skips the other checks.
+std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOptions* options);
+std::string sequence_usage(const std::string& program);
+
+// An empty string when `path` can be created as a file (its directory exists and is
+// writable), else why not.
+std::string check_writable_file(const std::string& path);
+
+// Frame i's stamp in nanoseconds: 1 s + i / rate, exactly (integer arithmetic).
+uint64_t frame_stamp_ns(int i, double rate);
+
+struct Sequence {
+  SequenceOptions options;
+  Scene scene;
+  Trajectory trajectory;
+  PinholeCamera camera;  // both cameras of a stereo pair
+  RenderOptions render;
+};
+
+// Builds the scene and trajectory. Throws std::invalid_argument for invalid options.
+Sequence make_sequence(const SequenceOptions& options);
+
+// Renders frame i of the left camera, or of the right one (stereo: centre shifted by the
+// baseline along the left camera's x axis). The noise differs per frame and camera.
+RenderedView render_frame(const Sequence& sequence, int frame, bool right = false);
+CameraPose frame_pose(const Sequence& sequence, int frame, bool right = false);
+
+}  // namespace render
+}  // namespace hybrid_vo

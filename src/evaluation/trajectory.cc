@@ -1,0 +1,197 @@
+#include "hybrid_vo/evaluation/trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+
+#include "hybrid_vo/geometry/pose_error.h"
+
+namespace hybrid_vo {
+namespace evaluation {
+
+bool pose_at(const Trajectory& trajectory, double stamp, double tolerance, StampedPose* pose) {
+  if (trajectory.empty()) return false;
+  const auto it = std::lower_bound(
+      trajectory.begin(), trajectory.end(), stamp,
+      [](const StampedPose& p, double s) { return p.stamp < s; });
+  const StampedPose* best = nullptr;
+  double best_gap = tolerance;
+  for (auto c = it == trajectory.begin() ? it : it - 1; c != trajectory.end() && c <= it; ++c) {
+    const double gap = std::abs(c->stamp - stamp);
+    if (gap <= best_gap) best_gap = gap, best = &*c;
+  }
+  if (!best) return false;
+  *pose = *best;
+  return true;
+}
+
+bool umeyama(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
+             bool with_scale, Eigen::Matrix3d* R, Eigen::Vector3d* t, double* s) {
+  const size_t n = std::min(from.size(), to.size());
+  if (n < 3) return false;
+  Eigen::Vector3d mf = Eigen::Vector3d::Zero(), mt = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) mf += from[i], mt += to[i];
+  mf /= n;
+  mt /= n;
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  double var = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    C += (to[i] - mt) * (from[i] - mf).transpose();
+    var += (from[i] - mf).squaredNorm();
+  }
+  C /= n;
+  var /= n;
+  if (!(var > 0.0)) return false;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0) D(2, 2) = -1.0;
+  *R = svd.matrixU() * D * svd.matrixV().transpose();
+  *s = with_scale ? (svd.singularValues().asDiagonal() * D).trace() / var : 1.0;
+  *t = mt - *s * *R * mf;
+  return std::isfinite(*s) && *s > 0.0;
+}
+
+namespace {
+
+double angle_deg(const Eigen::Matrix3d& R) {
+  return rotation_error(Eigen::Matrix3d::Identity(), R) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+TrajectoryErrors compare_trajectories(const Trajectory& estimate, const Trajectory& truth,
+                                      bool with_scale, double tolerance,
+                                      std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>*
+                                          aligned) {
+  TrajectoryErrors e;
+  std::vector<StampedPose> est, gt;
+  for (const StampedPose& p : estimate) {
+    StampedPose g;
+    if (!pose_at(truth, p.stamp, tolerance, &g)) continue;
+    est.push_back(p);
+    gt.push_back(g);
+  }
+  if (est.size() < 2) return e;
+  std::vector<Eigen::Vector3d> ce, cg;
+  for (size_t i = 0; i < est.size(); ++i) {
+    ce.push_back(est[i].c);
+    cg.push_back(gt[i].c);
+  }
+  Eigen::Matrix3d Ra = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d ta = Eigen::Vector3d::Zero();
+  double s = 1.0;
+  if (!umeyama(ce, cg, with_scale, &Ra, &ta, &s)) {
+    // Too few or collinear-free points: align the first pose only.
+    Ra = gt[0].R * est[0].R.transpose();
+    ta = gt[0].c - Ra * est[0].c;
+    s = 1.0;
+  }
+  e.scale = s;
+  double ate = 0.0;
+  for (size_t i = 0; i < est.size(); ++i) {
+    const Eigen::Vector3d a = s * Ra * est[i].c + ta;
+    ate += (a - gt[i].c).squaredNorm();
+    if (aligned) aligned->emplace_back(a, gt[i].c);
+  }
+  e.ate = std::sqrt(ate / est.size());
+
+  double rpe_t = 0.0, rpe_r = 0.0;
+  for (size_t i = 0; i + 1 < est.size(); ++i) {
+    const Eigen::Matrix3d dRe = est[i].R.transpose() * est[i + 1].R;
+    const Eigen::Matrix3d dRg = gt[i].R.transpose() * gt[i + 1].R;
+    const Eigen::Vector3d dte = s * est[i].R.transpose() * (est[i + 1].c - est[i].c);
+    const Eigen::Vector3d dtg = gt[i].R.transpose() * (gt[i + 1].c - gt[i].c);
+    const double rot = angle_deg(dRe.transpose() * dRg);
+    e.rot_err_deg.push_back(rot);
+    e.dir_err_deg.push_back(translation_error(dte, dtg) * 180.0 / M_PI);
+    rpe_t += (dte - dtg).squaredNorm();
+    rpe_r += rot * rot;
+    ++e.pairs;
+  }
+  e.rpe_trans = std::sqrt(rpe_t / e.pairs);
+  e.rpe_rot_deg = std::sqrt(rpe_r / e.pairs);
+
+  // Drift over sub-sequences (KITTI devkit style), with fractions of the path when it is short.
+  std::vector<double> distance(gt.size(), 0.0);
+  for (size_t i = 1; i < gt.size(); ++i) distance[i] = distance[i - 1] + (gt[i].c - gt[i - 1].c).norm();
+  const double total = distance.back();
+  std::vector<double> lengths;
+  if (total >= 200.0) {
+    for (double l = 100.0; l <= 800.0 && l < total; l += 100.0) lengths.push_back(l);
+  } else if (total > 0.0) {
+    for (double f : {0.25, 0.5, 0.75}) lengths.push_back(f * total);
+  }
+  double trans_sum = 0.0, rot_sum = 0.0;
+  for (size_t first = 0; first < gt.size(); first += 5) {
+    for (double length : lengths) {
+      size_t last = first;
+      while (last < gt.size() && distance[last] - distance[first] < length) ++last;
+      if (last >= gt.size()) break;
+      const Eigen::Matrix3d dRe = est[first].R.transpose() * est[last].R;
+      const Eigen::Matrix3d dRg = gt[first].R.transpose() * gt[last].R;
+      const Eigen::Vector3d dte = s * est[first].R.transpose() * (est[last].c - est[first].c);
+      const Eigen::Vector3d dtg = gt[first].R.transpose() * (gt[last].c - gt[first].c);
+      trans_sum += (dRg.transpose() * (dte - dtg)).norm() / length * 100.0;
+      rot_sum += angle_deg(dRg.transpose() * dRe) / length * 100.0;
+      ++e.drift_segments;
+    }
+  }
+  if (e.drift_segments > 0) {
+    e.drift_trans_percent = trans_sum / e.drift_segments;
+    e.drift_rot_deg_per_100m = rot_sum / e.drift_segments;
+  }
+  return e;
+}
+
+bool read_tum_trajectory(const std::string& path, Trajectory* trajectory, std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    *error = path + ": cannot open";
+    return false;
+  }
+  trajectory->clear();
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    double v[8];
+    int n = 0;
+    while (n < 8 && fields >> v[n]) ++n;
+    std::string extra;
+    if (n != 8 || (fields >> extra)) {
+      *error = path + ":" + std::to_string(number) + ": expected 8 numbers";
+      return false;
+    }
+    for (double x : v)
+      if (!std::isfinite(x)) {
+        *error = path + ":" + std::to_string(number) + ": non-finite number";
+        return false;
+      }
+    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+    if (!(q.norm() > 0.5)) {
+      *error = path + ":" + std::to_string(number) + ": not a unit quaternion";
+      return false;
+    }
+    StampedPose p;
+    p.stamp = v[0];
+    p.c = Eigen::Vector3d(v[1], v[2], v[3]);
+    p.R = q.normalized().toRotationMatrix();
+    trajectory->push_back(p);
+  }
+  std::sort(trajectory->begin(), trajectory->end(),
+            [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
+  if (trajectory->empty()) {
+    *error = path + ": no poses";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace evaluation
+}  // namespace hybrid_vo

@@ -1,0 +1,297 @@
+#include "hybrid_vo/render/renderer.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace hybrid_vo {
+namespace render {
+namespace {
+
+constexpr int kBands = 16;  // horizontal bands rendered in parallel; each pixel by one band
+
+// Per-quad constants of the ray-plane test: the plane world[a] = plane, and the quad's extent
+// along the two other world axes iu, iv.
+struct QuadRaster {
+  int index = 0;
+  int a = 0, iu = 0, iv = 0;
+  double plane = 0.0;
+  double lo_u = 0.0, hi_u = 0.0, lo_v = 0.0, hi_v = 0.0;
+  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // sample bounding box, inclusive
+};
+
+struct SampleGrid {
+  int ss = 1, width = 0, height = 0;  // samples
+  std::vector<float> depth;
+  std::vector<int> id;
+};
+
+// Sample (i, j) of a grid with ss samples per pixel looks through image point
+// ((i + 0.5) / ss - 0.5, (j + 0.5) / ss - 0.5).
+double sample_coord(int i, int ss) { return (i + 0.5) / ss - 0.5; }
+
+std::vector<QuadRaster> setup_quads(const Scene& scene, const PinholeCamera& cam,
+                                    const CameraPose& pose, int ss, double near, int width,
+                                    int height) {
+  std::vector<QuadRaster> out;
+  const Eigen::Matrix3d Rt = pose.R_world_from_camera.transpose();
+  for (size_t i = 0; i < scene.quads.size(); ++i) {
+    const Quad& q = scene.quads[i];
+    QuadRaster r;
+    r.index = static_cast<int>(i);
+    r.a = q.normal_axis();
+    r.plane = q.origin[r.a];
+    // One-sided: the camera must be on the side the normal points to.
+    if (q.normal[r.a] * (pose.centre[r.a] - r.plane) <= 1e-9) continue;
+    q.u_axis.cwiseAbs().maxCoeff(&r.iu);
+    q.v_axis.cwiseAbs().maxCoeff(&r.iv);
+    const Eigen::Vector3d far = q.point(q.size_u, q.size_v);
+    r.lo_u = std::min(q.origin[r.iu], far[r.iu]);
+    r.hi_u = std::max(q.origin[r.iu], far[r.iu]);
+    r.lo_v = std::min(q.origin[r.iv], far[r.iv]);
+    r.hi_v = std::max(q.origin[r.iv], far[r.iv]);
+    // Clip the quad to z >= near in the camera and bound its projection.
+    std::array<Eigen::Vector3d, 4> corners = {
+        Rt * (q.origin - pose.centre), Rt * (q.point(q.size_u, 0) - pose.centre),
+        Rt * (far - pose.centre), Rt * (q.point(0, q.size_v) - pose.centre)};
+    std::vector<Eigen::Vector3d> clipped;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d& p = corners[k];
+      const Eigen::Vector3d& n = corners[(k + 1) % 4];
+      if (p.z() >= near) clipped.push_back(p);
+      if ((p.z() >= near) != (n.z() >= near))
+        clipped.push_back(p + (n - p) * ((near - p.z()) / (n.z() - p.z())));
+    }
+    if (clipped.empty()) continue;
+    double x_min = std::numeric_limits<double>::max(), x_max = -x_min;
+    double y_min = x_min, y_max = -x_min;
+    for (const Eigen::Vector3d& p : clipped) {
+      const double x = cam.fx * p.x() / p.z() + cam.cx, y = cam.fy * p.y() / p.z() + cam.cy;
+      x_min = std::min(x_min, x);
+      x_max = std::max(x_max, x);
+      y_min = std::min(y_min, y);
+      y_max = std::max(y_max, y);
+    }
+    // Image point x is sample (x + 0.5) * ss - 0.5; one sample of slack for rounding.
+    auto to_sample = [ss](double x) { return (x + 0.5) * ss - 0.5; };
+    const double big = 1e7;
+    r.x0 = static_cast<int>(std::max(0.0, std::floor(std::max(-big, to_sample(x_min))) - 1));
+    r.x1 = static_cast<int>(std::min(width - 1.0, std::ceil(std::min(big, to_sample(x_max))) + 1));
+    r.y0 = static_cast<int>(std::max(0.0, std::floor(std::max(-big, to_sample(y_min))) - 1));
+    r.y1 = static_cast<int>(std::min(height - 1.0, std::ceil(std::min(big, to_sample(y_max))) + 1));
+    if (r.x0 > r.x1 || r.y0 > r.y1) continue;
+    out.push_back(r);
+  }
+  return out;
+}
+
+// The nearest quad hit by every sample's ray. The ray direction R (xn, yn, 1) has camera z = 1,
+// so its parameter at the hit is the camera depth.
+SampleGrid rasterize(const Scene& scene, const PinholeCamera& cam, const CameraPose& pose, int ss,
+                     double near) {
+  SampleGrid grid;
+  grid.ss = ss;
+  grid.width = cam.width * ss;
+  grid.height = cam.height * ss;
+  grid.depth.assign(static_cast<size_t>(grid.width) * grid.height,
+                    std::numeric_limits<float>::infinity());
+  grid.id.assign(grid.depth.size(), -1);
+  const std::vector<QuadRaster> quads =
+      setup_quads(scene, cam, pose, ss, near, grid.width, grid.height);
+  const Eigen::Matrix3d& R = pose.R_world_from_camera;
+  const Eigen::Vector3d& c = pose.centre;
+  std::vector<double> xn(grid.width);
+  for (int i = 0; i < grid.width; ++i) xn[i] = (sample_coord(i, ss) - cam.cx) / cam.fx;
+
+  cv::parallel_for_(cv::Range(0, kBands), [&](const cv::Range& bands) {
+    for (int band = bands.start; band < bands.end; ++band) {
+      const int row0 = band * grid.height / kBands, row1 = (band + 1) * grid.height / kBands;
+      for (const QuadRaster& q : quads) {
+        const int y0 = std::max(q.y0, row0), y1 = std::min(q.y1, row1 - 1);
+        for (int j = y0; j <= y1; ++j) {
+          const double yn = (sample_coord(j, ss) - cam.cy) / cam.fy;
+          const Eigen::Vector3d base = R.col(2) + yn * R.col(1);
+          float* depth = &grid.depth[static_cast<size_t>(j) * grid.width];
+          int* id = &grid.id[static_cast<size_t>(j) * grid.width];
+          const double ca = c[q.a], cu = c[q.iu], cv = c[q.iv];
+          const double ra = R(q.a, 0), ru = R(q.iu, 0), rv = R(q.iv, 0);
+          for (int i = q.x0; i <= q.x1; ++i) {
+            const double da = base[q.a] + xn[i] * ra;
+            const double t = (q.plane - ca) / da;
+            if (!(t > near) || t >= depth[i]) continue;
+            const double hu = cu + t * (base[q.iu] + xn[i] * ru);
+            if (hu < q.lo_u || hu > q.hi_u) continue;
+            const double hv = cv + t * (base[q.iv] + xn[i] * rv);
+            if (hv < q.lo_v || hv > q.hi_v) continue;
+            depth[i] = static_cast<float>(t);
+            id[i] = q.index;
+          }
+        }
+      }
+    }
+  });
+  return grid;
+}
+
+float bilinear(const cv::Mat& m, double x, double y) {
+  x = std::clamp(x, 0.0, m.cols - 1.0);
+  y = std::clamp(y, 0.0, m.rows - 1.0);
+  const int x0 = std::min(static_cast<int>(x), m.cols - 2 < 0 ? 0 : m.cols - 2);
+  const int y0 = std::min(static_cast<int>(y), m.rows - 2 < 0 ? 0 : m.rows - 2);
+  const int x1 = std::min(x0 + 1, m.cols - 1), y1 = std::min(y0 + 1, m.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  if (m.type() == CV_8UC1) {
+    const uchar* r0 = m.ptr<uchar>(y0);
+    const uchar* r1 = m.ptr<uchar>(y1);
+    const double top = r0[x0] + fx * (r0[x1] - r0[x0]);
+    const double bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
+    return static_cast<float>(top + fy * (bottom - top));
+  }
+  const float* r0 = m.ptr<float>(y0);
+  const float* r1 = m.ptr<float>(y1);
+  const double top = r0[x0] + fx * (r0[x1] - r0[x0]);
+  const double bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
+  return static_cast<float>(top + fy * (bottom - top));
+}
+
+// Texture lookup at level-0 texel coordinates (tu, tv), texel c covering [c, c + 1); (du, dv)
+// per sample step along the image x and y axes give the footprint.
+double sample_texture(const Texture& tex, double tu, double tv, double dux, double dvx, double duy,
+                      double dvy, int max_anisotropy) {
+  const double lx = std::hypot(dux, dvx), ly = std::hypot(duy, dvy);
+  const bool x_major = lx >= ly;
+  const double major = x_major ? lx : ly, minor = std::max(x_major ? ly : lx, 1e-9);
+  const double au = x_major ? dux : duy, av = x_major ? dvx : dvy;
+  const int taps = std::clamp(static_cast<int>(std::ceil(major / minor - 1e-6)), 1, max_anisotropy);
+  const double footprint = std::max(minor, major / taps);
+  const int top_level = static_cast<int>(tex.levels.size()) - 1;
+  const double lod =
+      std::clamp(std::log2(std::max(footprint, 1e-9)), 0.0, static_cast<double>(top_level));
+  const int l0 = std::min(static_cast<int>(lod), top_level);
+  const int l1 = std::min(l0 + 1, top_level);
+  const double f = lod - l0;
+  const double s0 = 1.0 / (1 << l0), s1 = 1.0 / (1 << l1);
+  double sum = 0.0;
+  for (int k = 0; k < taps; ++k) {
+    const double o = (k + 0.5) / taps - 0.5;
+    const double u = tu + o * au, v = tv + o * av;
+    double value = bilinear(tex.levels[l0], u * s0 - 0.5, v * s0 - 0.5);
+    if (f > 1e-3 && l1 != l0)
+      value += f * (bilinear(tex.levels[l1], u * s1 - 0.5, v * s1 - 0.5) - value);
+    sum += value;
+  }
+  return sum / taps;
+}
+
+void check(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("render: " + what);
+}
+
+}  // namespace
+
+PinholeCamera default_camera(int width, int height) {
+  const double f = 0.72 * width;
+  return PinholeCamera(f, f, 0.5 * (width - 1), 0.5 * (height - 1), width, height);
+}
+
+RenderedView render_view(const Scene& scene, const PinholeCamera& cam, const CameraPose& pose,
+                         const RenderOptions& o) {
+  check(cam.valid() && cam.width >= 1 && cam.height >= 1 && cam.width <= 8192 && cam.height <= 8192,
+        "the camera needs valid intrinsics and a size in [1, 8192]");
+  check(o.supersampling >= 1 && o.supersampling <= 8, "supersampling must be in [1, 8]");
+  check(std::isfinite(o.blur_sigma) && o.blur_sigma >= 0.0 && o.blur_sigma <= 10.0,
+        "blur_sigma must be in [0, 10]");
+  check(std::isfinite(o.noise_sigma) && o.noise_sigma >= 0.0 && o.noise_sigma <= 100.0,
+        "noise_sigma must be in [0, 100]");
+  check(o.max_anisotropy >= 1 && o.max_anisotropy <= 16, "max_anisotropy must be in [1, 16]");
+  check(std::isfinite(o.exposure) && o.exposure > 0.0, "exposure must be positive");
+  check(std::isfinite(o.near) && o.near > 0.0, "near must be positive");
+  check(pose.R_world_from_camera.allFinite() && pose.centre.allFinite() &&
+            (pose.R_world_from_camera.transpose() * pose.R_world_from_camera -
+             Eigen::Matrix3d::Identity())
+                    .norm() < 1e-6,
+        "the pose needs a finite rotation matrix and centre");
+
+  const int ss = o.supersampling;
+  const SampleGrid grid = rasterize(scene, cam, pose, ss, o.near);
+  const Eigen::Matrix3d& R = pose.R_world_from_camera;
+  const Eigen::Vector3d& c = pose.centre;
+  // Ray direction change per sample step along x and y.
+  const Eigen::Vector3d ex = R.col(0) / (cam.fx * ss), ey = R.col(1) / (cam.fy * ss);
+
+  cv::Mat radiance(cam.height, cam.width, CV_32FC1);
+  cv::parallel_for_(cv::Range(0, kBands), [&](const cv::Range& bands) {
+    for (int band = bands.start; band < bands.end; ++band) {
+      for (int y = band * cam.height / kBands; y < (band + 1) * cam.height / kBands; ++y) {
+        float* out = radiance.ptr<float>(y);
+        for (int x = 0; x < cam.width; ++x) {
+          double sum = 0.0;
+          for (int sj = 0; sj < ss; ++sj) {
+            const int j = y * ss + sj;
+            const double yn = (sample_coord(j, ss) - cam.cy) / cam.fy;
+            for (int si = 0; si < ss; ++si) {
+              const int i = x * ss + si;
+              const size_t k = static_cast<size_t>(j) * grid.width + i;
+              const int id = grid.id[k];
+              if (id < 0) continue;
+              const Quad& q = scene.quads[id];
+              const double t = grid.depth[k];
+              const double xn = (sample_coord(i, ss) - cam.cx) / cam.fx;
+              const Eigen::Vector3d d = R.col(2) + xn * R.col(0) + yn * R.col(1);
+              const Eigen::Vector3d X = c + t * d;
+              const Eigen::Vector2d uv = q.local(X);
+              // Footprint: dX = t (e - d (n . e) / (n . d)) for a ray step e.
+              const double nd = q.normal.dot(d);
+              const Eigen::Vector3d dX_dx = t * (ex - d * (q.normal.dot(ex) / nd));
+              const Eigen::Vector3d dX_dy = t * (ey - d * (q.normal.dot(ey) / nd));
+              const double tpm = q.texture.texels_per_metre;
+              const double albedo =
+                  sample_texture(q.texture, uv.x() * tpm, uv.y() * tpm, dX_dx.dot(q.u_axis) * tpm,
+                                 dX_dx.dot(q.v_axis) * tpm, dX_dy.dot(q.u_axis) * tpm,
+                                 dX_dy.dot(q.v_axis) * tpm, o.max_anisotropy);
+              const double lpm = q.lightmap_per_metre;
+              const double light = bilinear(q.lightmap, uv.x() * lpm - 0.5, uv.y() * lpm - 0.5);
+              sum += albedo * light;
+            }
+          }
+          out[x] = static_cast<float>(o.exposure * sum / (ss * ss));
+        }
+      }
+    }
+  });
+
+  if (o.blur_sigma > 0.0)
+    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), o.blur_sigma, o.blur_sigma,
+                     cv::BORDER_REFLECT);
+  if (o.noise_sigma > 0.0) {
+    cv::Mat noise(radiance.size(), CV_32FC1);
+    cv::RNG rng(o.noise_seed * 0x9E3779B97F4A7C15ull + 1);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
+    radiance += noise;
+  }
+  RenderedView view;
+  radiance.convertTo(view.image, CV_8U);
+
+  // Depth and quad at the pixel centres: the middle sample for odd ss, else one more pass.
+  const SampleGrid centres = ss % 2 == 1 ? SampleGrid() : rasterize(scene, cam, pose, 1, o.near);
+  const SampleGrid& g = ss % 2 == 1 ? grid : centres;
+  const int gs = ss % 2 == 1 ? ss : 1, mid = gs / 2;
+  view.depth = cv::Mat(cam.height, cam.width, CV_32FC1);
+  view.quad_id = cv::Mat(cam.height, cam.width, CV_32SC1);
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) {
+      const size_t k = static_cast<size_t>(y * gs + mid) * g.width + x * gs + mid;
+      view.quad_id.at<int>(y, x) = g.id[k];
+      view.depth.at<float>(y, x) = g.id[k] >= 0 ? g.depth[k] : 0.0f;
+    }
+  return view;
+}
+
+}  // namespace render
+}  // namespace hybrid_vo

@@ -1,0 +1,194 @@
+#include "hybrid_vo/render/sequence.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+#include "painter.h"
+
+namespace hybrid_vo {
+namespace render {
+namespace {
+
+bool parse_int(const std::string& s, int lo, int hi, int* out) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(s.c_str(), &end, 10);
+  if (s.empty() || *end || errno || v < lo || v > hi) return false;
+  *out = static_cast<int>(v);
+  return true;
+}
+
+bool parse_double(const std::string& s, double lo, double hi, bool open_lo, double* out) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || *end || !std::isfinite(v) || v > hi || v < lo || (open_lo && v == lo))
+    return false;
+  *out = v;
+  return true;
+}
+
+bool parse_u64(const std::string& s, uint64_t* out) {
+  if (s.empty() || s[0] == '-') return false;
+  char* end = nullptr;
+  errno = 0;
+  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+  if (*end || errno) return false;
+  *out = v;
+  return true;
+}
+
+}  // namespace
+
+std::string sequence_usage(const std::string& program) {
+  std::ostringstream s;
+  s << "Usage: " << program << " --out OUT.bag [options]\n"
+    << "Renders a synthetic Manhattan sequence (textured corridor or room, a walk with turns)\n"
+    << "into a bag: /camera/left/{image_raw,camera_info} (and /camera/right/... with --stereo),\n"
+    << "/ground_truth/pose, /tf (world -> gt_camera_left_optical) and /tf_static.\n"
+    << "  --frames N         frames (default 150)\n"
+    << "  --laps L           instead of --frames: L laps of the closed route (e.g. 1 for a loop)\n"
+    << "  --stereo           also render the right camera\n"
+    << "  --width W --height H  image size (default 640 x 480)\n"
+    << "  --rate HZ          frame rate (default 10)\n"
+    << "  --seed S           scene, walk and noise seed (default 1)\n"
+    << "  --scene corridor|room  (default corridor)\n"
+    << "  --baseline M       stereo baseline in metres (default 0.12)\n"
+    << "  --speed M_PER_S    walking speed (default 1.5)\n"
+    << "  --focal PX         focal length (default 0.72 * width)\n"
+    << "  --noise SIGMA      image noise in grey levels (default 1)\n"
+    << "  --supersampling K  K x K rays per pixel (default 3)\n"
+    << "  --compression none|lz4|bz2  bag compression (default lz4)\n"
+    << "  --png-dir DIR      also write the images as PNG files\n";
+  return s.str();
+}
+
+std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOptions* o) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg == "--help" || arg == "-h") {
+      o->help = true;
+      return "";
+    }
+    if (arg == "--stereo") {
+      o->stereo = true;
+      continue;
+    }
+    static const char* kValued[] = {"--out",           "--png-dir",    "--frames", "--width",
+                                    "--height",        "--rate",       "--seed",   "--scene",
+                                    "--baseline",      "--speed",      "--focal",  "--noise",
+                                    "--supersampling", "--compression", "--laps"};
+    bool known = false;
+    for (const char* name : kValued) known = known || arg == name;
+    if (!known) return "unknown argument '" + arg + "'";
+    if (i + 1 >= args.size()) return arg + " needs a value";
+    const std::string& v = args[++i];
+    bool ok = true;
+    if (arg == "--out") {
+      o->out_bag = v;
+      ok = !v.empty();
+    } else if (arg == "--png-dir") {
+      o->png_dir = v;
+      ok = !v.empty();
+    } else if (arg == "--frames") {
+      ok = parse_int(v, 1, 100000, &o->frames);
+    } else if (arg == "--laps") {
+      ok = parse_double(v, 0.0, 100.0, true, &o->laps);
+    } else if (arg == "--width") {
+      ok = parse_int(v, 16, 4096, &o->width);
+    } else if (arg == "--height") {
+      ok = parse_int(v, 16, 4096, &o->height);
+    } else if (arg == "--rate") {
+      ok = parse_double(v, 0.0, 1000.0, true, &o->rate);
+    } else if (arg == "--seed") {
+      ok = parse_u64(v, &o->seed);
+    } else if (arg == "--scene") {
+      ok = parse_scene_type(v, &o->scene);
+    } else if (arg == "--baseline") {
+      ok = parse_double(v, 0.0, 2.0, true, &o->baseline);
+    } else if (arg == "--speed") {
+      ok = parse_double(v, 0.0, 5.0, true, &o->speed);
+    } else if (arg == "--focal") {
+      ok = parse_double(v, 0.0, 1e5, true, &o->focal);
+    } else if (arg == "--noise") {
+      ok = parse_double(v, 0.0, 50.0, false, &o->noise);
+    } else if (arg == "--supersampling") {
+      ok = parse_int(v, 1, 8, &o->supersampling);
+    } else if (arg == "--compression") {
+      o->compression = v;
+      ok = v == "none" || v == "lz4" || v == "bz2";
+    }
+    if (!ok) return "bad value '" + v + "' for " + arg;
+  }
+  if (o->out_bag.empty()) return "--out OUT.bag is required";
+  return "";
+}
+
+std::string check_writable_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return "empty path";
+  std::error_code ec;
+  const fs::path p(path);
+  if (fs::is_directory(p, ec)) return "'" + path + "' is a directory";
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir, ec)) return "directory '" + dir.string() + "' does not exist";
+  if (::access(dir.c_str(), W_OK) != 0) return "directory '" + dir.string() + "' is not writable";
+  if (fs::exists(p, ec) && ::access(p.c_str(), W_OK) != 0) return "'" + path + "' is not writable";
+  return "";
+}
+
+uint64_t frame_stamp_ns(int i, double rate) {
+  return 1000000000ull + static_cast<uint64_t>(std::llround(i * (1e9 / rate)));
+}
+
+Sequence make_sequence(const SequenceOptions& options) {
+  Sequence seq;
+  seq.options = options;
+  SceneOptions scene;
+  scene.type = options.scene;
+  scene.seed = options.seed;
+  seq.scene = build_scene(scene);
+  if (options.laps > 0.0) {
+    const double frames =
+        std::round(options.laps * route_length(seq.scene) / options.speed * options.rate);
+    if (!(frames >= 2.0 && frames <= 1e6))
+      throw std::invalid_argument("render sequence: --laps gives " + std::to_string(frames) +
+                                  " frames");
+    seq.options.frames = static_cast<int>(frames);
+  }
+  PathOptions path;
+  path.num_frames = seq.options.frames;
+  path.rate_hz = options.rate;
+  path.speed = options.speed;
+  path.seed = options.seed;
+  seq.trajectory = make_trajectory(seq.scene, path);
+  seq.camera = default_camera(options.width, options.height);
+  if (options.focal > 0.0) seq.camera.fx = seq.camera.fy = options.focal;
+  seq.render.supersampling = options.supersampling;
+  seq.render.noise_sigma = options.noise;
+  if (options.stereo && !(options.baseline > 0.0))
+    throw std::invalid_argument("render sequence: the stereo baseline must be positive");
+  return seq;
+}
+
+CameraPose frame_pose(const Sequence& seq, int frame, bool right) {
+  if (frame < 0 || frame >= static_cast<int>(seq.trajectory.poses.size()))
+    throw std::out_of_range("render sequence: no frame " + std::to_string(frame));
+  const CameraPose& left = seq.trajectory.poses[frame];
+  return right ? stereo_right(left, seq.options.baseline) : left;
+}
+
+RenderedView render_frame(const Sequence& seq, int frame, bool right) {
+  RenderOptions render = seq.render;
+  render.noise_seed =
+      hash_mix(seq.options.seed, 2 * static_cast<uint64_t>(frame) + (right ? 1 : 0));
+  return render_view(seq.scene, seq.camera, frame_pose(seq, frame, right), render);
+}
+
+}  // namespace render
+}  // namespace hybrid_vo
