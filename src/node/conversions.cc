@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sensor_msgs/distortion_models.h>
 #include <sensor_msgs/image_encodings.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 namespace hybrid_vo {
 
@@ -244,5 +245,12 @@ geometry_msgs::Transform to_transform(const Eigen::Matrix3d& R, const Eigen::Vec
   tf.translation.z = t.z();
   return tf;
 }
+
+geometry_msgs::Vector3 to_vector(const Eigen::Vector3d& v) {
+  geometry_msgs::Vector3 m;
+  return tf2::toMsg(v, m);
+}
+
+geometry_msgs::Point to_point(const Eigen::Vector3d& p) { return tf2::toMsg(p); }
 
 }  // namespace hybrid_vo

@@ -3,7 +3,9 @@
 #include <string>
 #include <vector>
 
+#include <geometry_msgs/Point.h>
 #include <geometry_msgs/Transform.h>
+#include <geometry_msgs/Vector3.h>
 #include <hybrid_vo/FeatureLines.h>
 #include <hybrid_vo/FeaturePoints.h>
 #include <opencv2/core.hpp>
@@ -44,5 +46,7 @@ bool lines_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& ca
                      ExternalFeatures* features, std::string* reason);
 
 geometry_msgs::Transform to_transform(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+geometry_msgs::Vector3 to_vector(const Eigen::Vector3d& v);
+geometry_msgs::Point to_point(const Eigen::Vector3d& p);
 
 }  // namespace hybrid_vo

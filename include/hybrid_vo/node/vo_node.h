@@ -10,6 +10,8 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <diagnostic_updater/update_functions.h>
+#include <Eigen/Geometry>
+#include <geometry_msgs/TransformStamped.h>
 #include <hybrid_vo/FeatureLines.h>
 #include <hybrid_vo/FeaturePoints.h>
 #include <image_transport/image_transport.h>
@@ -27,6 +29,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
+#include <visualization_msgs/Marker.h>
 
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/node/frame_queue.h"
@@ -57,7 +60,24 @@ class VoNode {
     sensor_msgs::PointCloud::ConstPtr vins_points, vins_lines;
   };
 
+  // Parameters and processing (vo_node.cc).
   void load_parameters();
+  void load_odometry_options();
+  // The processing thread: frames from the queue, one at a time, in arrival order.
+  void run();
+  void process(const Frame& frame);
+  // The frame's cameras, images and features for the odometry; false when one is unusable (the
+  // frame is rejected and counted).
+  bool read_input(const Frame& frame, VisualOdometryInput* input);
+  // The frame's outcome for the diagnostics.
+  void record_result(const Frame& frame, const VisualOdometryResult& result, bool lost);
+  // Resets or restarts the odometry for a fault in the stream (a valid frame of this stamp and
+  // size); false to skip the frame.
+  bool handle_stream_event(const ros::Time& stamp, int width, int height, bool* lost);
+  bool reset_callback(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
+  void reset_state(const std::string& why);
+
+  // Inputs and synchronisation (vo_node_inputs.cc).
   void subscribe();
   void mono_callback(const sensor_msgs::ImageConstPtr& image,
                      const sensor_msgs::CameraInfoConstPtr& info);
@@ -70,27 +90,48 @@ class VoNode {
   void lines_callback(const FeatureLines::ConstPtr& msg);
   void vins_points_callback(const sensor_msgs::PointCloud::ConstPtr& msg);
   void vins_lines_callback(const sensor_msgs::PointCloud::ConstPtr& msg);
-  bool reset_callback(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
-  void watchdog(const ros::TimerEvent&);
-
+  // The synchronised images of a frame (right and right_info null for mono).
+  void add_images(const sensor_msgs::ImageConstPtr& left,
+                  const sensor_msgs::CameraInfoConstPtr& left_info,
+                  const sensor_msgs::ImageConstPtr& right,
+                  const sensor_msgs::CameraInfoConstPtr& right_info);
+  template <class MessagePtr>
+  void add_features(const MessagePtr& msg, MessagePtr Frame::*part, bool Frame::*have);
   // Frames wait here until every part (images, and the feature topics in use) has arrived.
   Frame& pending(const ros::Time& stamp);
   void try_process(const ros::Time& stamp);
-  // The processing thread: frames from the queue, one at a time, in arrival order.
-  void run();
-  void process(const Frame& frame);
-  // Resets or restarts the odometry for a fault in the stream (a valid frame of this stamp and
-  // size); false to skip the frame.
-  bool handle_stream_event(const ros::Time& stamp, int width, int height, bool* lost);
+
+  // Publishing of the motion, pose, tf, Odometry, path and VPs (vo_node_publishing.cc).
   void publish(const Frame& frame, const VisualOdometryInput& input,
                const VisualOdometryResult& result, bool lost);
+  void publish_relative_pose(const Frame& frame, const VisualOdometryResult& result, bool lost);
   // `lost`: the pose follows a fault in the stream, so its covariance says "unknown" (9999, as
   // viso2 reports a lost track).
   void publish_pose(const ros::Time& stamp, const std::string& camera_frame,
                     const VisualOdometryResult& result, bool lost);
-  void reject(const std::string& what, const std::string& reason, int* counter);
+  void look_up_base_transform(const std::string& camera_frame);
+  void publish_odometry(const geometry_msgs::TransformStamped& tf, const Eigen::Isometry3d& pose,
+                        bool lost);
+  void publish_vanishing_points(const ros::Time& stamp, const VisualOdometryResult& result);
+  // The odometry frame's orientation in the first camera's frame ("world"): the static base ->
+  // camera rotation when there is one.
+  Eigen::Matrix3d R_odom_world() const;
+
+  // Visualisation, only with subscribers (vo_node_visualisation.cc).
+  void publish_markers(const ros::Time& stamp, const VisualOdometryInput& input,
+                       const VisualOdometryResult& result);
+  visualization_msgs::Marker inlier_segments(const VisualOdometryInput& input,
+                                             const VisualOdometryResult& result) const;
+  void publish_debug_image(const Frame& frame, const VisualOdometryInput& input,
+                           const VisualOdometryResult& result);
+
+  // Diagnostics (vo_node_diagnostics.cc). reject counts a skipped frame and returns false.
+  bool reject(const std::string& what, const std::string& reason, int* counter);
+  void watchdog(const ros::TimerEvent&);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
-  void reset_state(const std::string& why);
+  // Under stats_mutex_.
+  void add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) const;
+  void add_counters(diagnostic_updater::DiagnosticStatusWrapper& status) const;
 
   ros::NodeHandle nh_, pnh_;
   image_transport::ImageTransport it_;

@@ -1,0 +1,212 @@
+// The node's outputs of the motion: ~relative_pose, tf, ~odometry, ~path and ~vanishing_points
+// (DESIGN.md, "The node"; as viso2_ros's odometer base class publishes tf and odometry).
+#include <Eigen/Geometry>
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <hybrid_vo/MotionEstimate.h>
+#include <hybrid_vo/VanishingPoints.h>
+#include <nav_msgs/Odometry.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "hybrid_vo/node/conversions.h"
+#include "hybrid_vo/node/vo_node.h"
+
+namespace hybrid_vo {
+namespace {
+
+uint8_t status_code(const VisualOdometryResult& r) {
+  switch (r.status) {
+    case VoStatus::kOk:
+      return MotionEstimate::STATUS_OK;
+    case VoStatus::kInvalidInput:
+      return MotionEstimate::STATUS_INVALID_INPUT;
+    case VoStatus::kTooFewFeatures:
+      return MotionEstimate::STATUS_TOO_LITTLE_DATA;
+    case VoStatus::kNoPose:
+      switch (r.estimate.estimate.status) {
+        case EstimationStatus::kTooLittleData:
+          return MotionEstimate::STATUS_TOO_LITTLE_DATA;
+        case EstimationStatus::kDegenerate:
+          return MotionEstimate::STATUS_DEGENERATE;
+        default:
+          return MotionEstimate::STATUS_NO_MODEL;
+      }
+    default:
+      return MotionEstimate::STATUS_SKIPPED;
+  }
+}
+
+// Matches, inliers, solver statistics and timings of a frame, into its message.
+void fill_statistics(const VisualOdometryResult& result, bool moved, MotionEstimate* rel) {
+  const RelativePoseEstimate& est = result.estimate.estimate;
+  rel->points = result.num_point_matches;
+  rel->lines = result.num_line_matches;
+  rel->point_inliers = est.num_point_inliers;
+  rel->line_inliers = est.num_line_inliers;
+  rel->junctions = est.junctions.size();
+  rel->junction_inliers = est.num_junction_inliers;
+  rel->vps = result.matches.vps.size();
+  rel->vp_inliers = est.num_vp_inliers;
+  for (const SolverInfo& info : solver_table()) {
+    const SolverStatistics& s = est.solvers[static_cast<int>(info.id)];
+    if (s.sampled == 0) continue;
+    rel->solvers.push_back(info.code);
+    rel->solver_sampled.push_back(s.sampled);
+    rel->solver_best.push_back(s.best);
+  }
+  if (moved) rel->best_solver = solver_info(est.best_solver).code;
+  rel->iterations = est.iterations;
+  rel->frontend_ms = result.frontend_ms;
+  rel->estimator_ms = result.estimator_ms;
+  rel->total_ms = result.total_ms;
+  rel->points_ms = result.stages.points_ms;
+  rel->redetect_ms = result.stages.redetect_ms;
+  rel->lines_ms = result.stages.lines_ms;
+  rel->line_matching_ms = result.stages.line_matching_ms;
+  rel->vps_ms = result.stages.vps_ms;
+  rel->ransac_ms = result.stages.ransac_ms;
+  rel->stereo_ms = result.stages.stereo_ms;
+}
+
+}  // namespace
+
+void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
+                     const VisualOdometryResult& result, bool lost) {
+  camera_frame_ = frame.frame_id;
+  publish_relative_pose(frame, result, lost);
+  if (result.status == VoStatus::kOk || result.status == VoStatus::kFirstFrame ||
+      result.status == VoStatus::kReset)
+    publish_pose(frame.stamp, frame.frame_id, result, lost);
+  publish_vanishing_points(frame.stamp, result);
+  if (publish_markers_ && markers_pub_.getNumSubscribers() > 0)
+    publish_markers(frame.stamp, input, result);
+  if (publish_debug_image_ && debug_image_pub_.getNumSubscribers() > 0)
+    publish_debug_image(frame, input, result);
+}
+
+void VoNode::publish_relative_pose(const Frame& frame, const VisualOdometryResult& result,
+                                   bool lost) {
+  MotionEstimate rel;
+  rel.header.stamp = frame.stamp;
+  rel.header.frame_id = frame.frame_id;
+  rel.reference_stamp = ros::Time(result.reference_stamp);
+  rel.reference_frame_id = frame.frame_id;
+  rel.status = status_code(result);
+  const std::string& message = lost ? monitor_.description() : result.message;
+  rel.status_text =
+      std::string(to_string(result.status)) + (message.empty() ? "" : ": " + message);
+  const bool moved = result.status == VoStatus::kOk;
+  rel.transform = moved ? to_transform(result.motion.R, result.motion.t)
+                        : to_transform(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  rel.scale_known = moved && result.scale_known;
+  if (moved && result.motion_covariance_valid) {
+    // The estimator's covariance for the translation as published, with a stereo scale's
+    // uncertainty along t.
+    for (int i = 0; i < 36; ++i) rel.covariance[i] = result.motion_covariance(i / 6, i % 6);
+  }
+  fill_statistics(result, moved, &rel);
+  relative_pose_pub_.publish(rel);
+}
+
+void VoNode::look_up_base_transform(const std::string& camera_frame) {
+  // The body frame sits at the camera through a (static) transform; odom starts at the body.
+  looked_up_base_ = true;
+  try {
+    const geometry_msgs::TransformStamped bc =
+        tf_buffer_.lookupTransform(base_frame_, camera_frame, ros::Time(0), ros::Duration(0.5));
+    const Eigen::Isometry3d T = tf2::transformToEigen(bc);
+    R_base_camera_ = T.rotation();
+    t_base_camera_ = T.translation();
+    have_base_transform_ = true;
+  } catch (const tf2::TransformException& e) {
+    have_base_transform_ = false;
+    ROS_INFO("hybrid_vo: no %s -> %s transform (%s); publishing %s -> %s", base_frame_.c_str(),
+             camera_frame.c_str(), e.what(), odom_frame_.c_str(), camera_frame.c_str());
+  }
+}
+
+void VoNode::publish_pose(const ros::Time& stamp, const std::string& camera_frame,
+                          const VisualOdometryResult& result, bool lost) {
+  if (!looked_up_base_) look_up_base_transform(camera_frame);
+  Eigen::Isometry3d camera_in_world = Eigen::Isometry3d::Identity();
+  camera_in_world.linear() = result.R_wc;
+  camera_in_world.translation() = result.centre;
+  Eigen::Isometry3d pose = camera_in_world;
+  std::string child = camera_frame;
+  if (have_base_transform_) {
+    Eigen::Isometry3d base_camera = Eigen::Isometry3d::Identity();
+    base_camera.linear() = R_base_camera_;
+    base_camera.translation() = t_base_camera_;
+    pose = base_camera * camera_in_world * base_camera.inverse();
+    child = base_frame_;
+  }
+  geometry_msgs::TransformStamped tf;
+  tf.header.stamp = stamp;
+  tf.header.frame_id = odom_frame_;
+  tf.child_frame_id = child;
+  tf.transform = to_transform(pose.rotation(), pose.translation());
+  if (publish_tf_) tf_broadcaster_.sendTransform(tf);
+  publish_odometry(tf, pose, lost);
+}
+
+void VoNode::publish_odometry(const geometry_msgs::TransformStamped& tf,
+                              const Eigen::Isometry3d& pose, bool lost) {
+  const ros::Time& stamp = tf.header.stamp;
+  nav_msgs::Odometry odometry;
+  odometry.header = tf.header;
+  odometry.child_frame_id = tf.child_frame_id;
+  odometry.pose.pose.position.x = pose.translation().x();
+  odometry.pose.pose.position.y = pose.translation().y();
+  odometry.pose.pose.position.z = pose.translation().z();
+  odometry.pose.pose.orientation = tf.transform.rotation;
+  if (lost) {
+    for (int i = 0; i < 6; ++i) {
+      odometry.pose.covariance[i * 7] = 9999.0;
+      odometry.twist.covariance[i * 7] = 9999.0;
+    }
+  }
+  if (!last_pose_stamp_.isZero() && stamp > last_pose_stamp_) {
+    const double dt = (stamp - last_pose_stamp_).toSec();
+    const Eigen::Vector3d velocity =
+        pose.rotation().transpose() * (pose.translation() - last_centre_) / dt;
+    odometry.twist.twist.linear = to_vector(velocity);
+  }
+  last_pose_stamp_ = stamp;
+  last_centre_ = pose.translation();
+  odometry_pub_.publish(odometry);
+
+  geometry_msgs::PoseStamped p;
+  p.header = tf.header;
+  p.pose = odometry.pose.pose;
+  path_.header = tf.header;
+  path_.poses.push_back(p);
+  // A bounded window: the latched path is serialised on every frame, so an unbounded one would
+  // cost more memory and time with every frame of a long run.
+  if (path_max_poses_ > 0 && path_.poses.size() > static_cast<size_t>(path_max_poses_))
+    path_.poses.erase(path_.poses.begin(), path_.poses.end() - path_max_poses_);
+  path_pub_.publish(path_);
+}
+
+Eigen::Matrix3d VoNode::R_odom_world() const {
+  return have_base_transform_ ? R_base_camera_ : Eigen::Matrix3d::Identity();
+}
+
+void VoNode::publish_vanishing_points(const ros::Time& stamp, const VisualOdometryResult& result) {
+  // Tracked VPs, in the odometry frame (the first camera's frame turned into odom_frame).
+  VanishingPoints vps;
+  vps.header.stamp = stamp;
+  vps.header.frame_id = odom_frame_;
+  for (const VpTrack& track : vo_->vp_tracker().tracks()) {
+    VanishingPoint vp;
+    vp.id = track.id;
+    vp.direction_odom = to_vector(R_odom_world() * track.direction);
+    vp.direction_camera = to_vector(result.R_wc.transpose() * track.direction);
+    vp.hits = track.hits;
+    vp.age = track.age;
+    vp.confident = track.confident;
+    vps.vps.push_back(vp);
+  }
+  vps_pub_.publish(vps);
+}
+
+}  // namespace hybrid_vo
