@@ -1,11 +1,14 @@
 // The KITTI and LaMAR bag converters (hybrid_vo/conversion) on fixtures that this test writes
 // from the synthetic renderer in each data set's own layout, read back with rosbag::View: images,
 // camera_info, stamps, ground truth and static transforms must round-trip. Broken inputs must
-// fail with the file and line and leave no bag behind. One test per converter runs the built
-// executable; the real KITTI excerpt is converted when ../shared/data is present.
+// fail with the file and line and leave no bag behind; so must a damaged image in the middle of
+// each kind of stream, and an undamaged one gives exactly one message per frame on every topic.
+// Tests run the built executables too; the real KITTI excerpt is converted when ../shared/data
+// is present.
 #include <sys/wait.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -27,6 +30,7 @@
 
 #include "converter_fixtures.h"
 #include "file_test_utils.h"
+#include "hybrid_vo/conversion/bag_writing.h"
 #include "hybrid_vo/conversion/kitti_to_bag.h"
 #include "hybrid_vo/conversion/lamar_to_bag.h"
 #include "hybrid_vo/render/sequence.h"
@@ -700,6 +704,297 @@ TEST(LamarToBag, RealPhoneQueryFrame) {
   EXPECT_NEAR(gt.pose.position.x, -16.152784, 1e-9);
   EXPECT_NEAR(gt.pose.position.y, 3.622267, 1e-9);
   EXPECT_NEAR(gt.pose.position.z, 30.62104, 1e-9);
+}
+
+// ------------------------------------------------------------------------------------------------
+// No data lost silently: a damaged frame in the middle of a stream stops the conversion, naming the
+// file, with no bag left; an undamaged stream gives exactly one message per frame on every topic.
+
+// A phone stream as LaMAR stores it: one camera per frame (cam_phone_<us>), colour images,
+// absolute timestamps, a pose per frame.
+struct PhoneSession {
+  LamarWriter writer;
+  int64_t t0 = 1600000000000000;
+
+  PhoneSession(const fs::path& dir, const Rendered& r) : writer(dir) {
+    for (size_t i = 0; i < r.left.size(); ++i) {
+      const std::string id = "cam_phone_" + std::to_string(us(i));
+      writer.sensors.push_back(LamarWriter::camera(id, r.seq.camera));
+      writer.trajectories.push_back(std::to_string(us(i)) + ", " + id + ", " +
+                                    LamarWriter::pose(isometry(r.left[i])));
+      cv::Mat colour;
+      cv::cvtColor(r.left_images[i], colour, cv::COLOR_GRAY2BGR);
+      writer.add_image(us(i), id, colour);
+    }
+  }
+  int64_t us(size_t i) const { return t0 + 100000 * static_cast<int64_t>(i); }
+};
+
+// Messages per topic by stamp; /tf_static (one latched message) left out.
+using Stamps = std::map<std::string, std::vector<ros::Time>>;
+
+Stamps stamps_by_topic(const std::string& path) {
+  Stamps stamps;
+  rosbag::Bag bag(path, rosbag::bagmode::Read);
+  for (const rosbag::MessageInstance& m : rosbag::View(bag))
+    if (m.getTopic() != "/tf_static") stamps[m.getTopic()].push_back(m.getTime());
+  return stamps;
+}
+
+// One stream of a converter, written into a fresh folder: the command that converts it to `bag`,
+// frame 3 of 5 (its file as stored, and for LaMAR its line in images.txt), and what a complete
+// bag holds: every frame's stamp once on each topic.
+struct StreamCase {
+  std::string command;
+  fs::path frame;
+  cv::Mat stored;      // frame 3's image as written (grey, or colour for the phone)
+  std::string listed;  // "<session>/images.txt:<line>: ", or "" where no list names the file
+  Stamps complete;
+};
+
+const int kDamagedFrame = 3;
+const std::string kBinDir = HYBRID_VO_BIN_DIR;
+
+StreamCase kitti_stream(const fs::path& dir, const fs::path& bag, bool stereo) {
+  const Rendered& r = kitti_rendering();
+  KittiFixture fixture(dir, r);
+  fixture.write();
+  StreamCase s;
+  s.command = kBinDir + "/hybrid_vo_kitti_to_bag --sequence " + fixture.sequence_dir().string() +
+              " --out " + bag.string() + (stereo ? " --stereo" : "");
+  // In stereo the right image alone is damaged: its left twin is already in the bag by then.
+  s.frame = fixture.image_path(stereo ? 1 : 0, kDamagedFrame);
+  s.stored = stereo ? r.right_images[kDamagedFrame] : r.left_images[kDamagedFrame];
+  std::vector<ros::Time> stamps;
+  for (size_t i = 0; i < r.left.size(); ++i) stamps.push_back(ros::Time(1.0 + fixture.time(i)));
+  for (const std::string side : {"left", "right"}) {
+    if (side == "right" && !stereo) continue;
+    s.complete["/camera/" + side + "/image_raw"] = stamps;
+    s.complete["/camera/" + side + "/camera_info"] = stamps;
+  }
+  s.complete["/ground_truth/pose"] = stamps;
+  s.complete["/tf"] = stamps;
+  return s;
+}
+
+std::string images_line(const LamarWriter& writer, const std::string& relative) {
+  for (size_t k = 0; k < writer.images.size(); ++k)
+    if (contains(writer.images[k], relative))
+      return (writer.dir / "images.txt").string() + ":" + std::to_string(k + 1) + ": ";
+  ADD_FAILURE() << relative << " not in images.txt";
+  return "";
+}
+
+StreamCase lamar_rig_stream(const fs::path& dir, const fs::path& bag) {
+  const Rendered& r = kitti_rendering();
+  RigSession session(dir / "session", r);
+  session.writer.write();
+  StreamCase s;
+  s.command = kBinDir + "/hybrid_vo_lamar_to_bag --session " + session.writer.dir.string() +
+              " --out " + bag.string();
+  const std::string relative =
+      "images/cam_right/" + std::to_string(100000 * kDamagedFrame) + ".png";
+  s.frame = session.writer.dir / "raw_data" / relative;
+  s.stored = r.right_images[kDamagedFrame];
+  s.listed = images_line(session.writer, relative);
+  std::vector<ros::Time> stamps;
+  for (size_t i = 0; i < r.left.size(); ++i) stamps.push_back(ros::Time(1.0 + 0.1 * i));
+  for (const std::string name : {"cam_left", "cam_right"}) {
+    s.complete["/camera/" + name + "/image_raw"] = stamps;
+    s.complete["/camera/" + name + "/camera_info"] = stamps;
+  }
+  s.complete["/ground_truth/pose"] = stamps;
+  s.complete["/tf"] = stamps;
+  return s;
+}
+
+StreamCase lamar_phone_stream(const fs::path& dir, const fs::path& bag) {
+  const Rendered& r = kitti_rendering();
+  PhoneSession session(dir / "session", r);
+  session.writer.write();
+  StreamCase s;
+  s.command = kBinDir + "/hybrid_vo_lamar_to_bag --session " + session.writer.dir.string() +
+              " --out " + bag.string();
+  const std::string id = "cam_phone_" + std::to_string(session.us(kDamagedFrame));
+  const std::string relative =
+      "images/" + id + "/" + std::to_string(session.us(kDamagedFrame)) + ".png";
+  s.frame = session.writer.dir / "raw_data" / relative;
+  cv::cvtColor(r.left_images[kDamagedFrame], s.stored, cv::COLOR_GRAY2BGR);
+  s.listed = images_line(session.writer, relative);
+  std::vector<ros::Time> stamps(r.left.size());
+  for (size_t i = 0; i < stamps.size(); ++i) stamps[i].fromNSec(session.us(i) * 1000);
+  s.complete["/camera/cam_phone/image_raw"] = stamps;
+  s.complete["/camera/cam_phone/camera_info"] = stamps;
+  s.complete["/ground_truth/pose"] = stamps;
+  s.complete["/tf"] = stamps;
+  return s;
+}
+
+struct StreamKind {
+  std::string what;
+  std::function<StreamCase(const fs::path& dir, const fs::path& bag)> make;
+};
+
+const std::vector<StreamKind>& streams() {
+  static const std::vector<StreamKind> all = {
+      {"KITTI mono", [](const fs::path& d, const fs::path& b) { return kitti_stream(d, b, false); }},
+      {"KITTI stereo, right image",
+       [](const fs::path& d, const fs::path& b) { return kitti_stream(d, b, true); }},
+      {"LaMAR rig, second camera", lamar_rig_stream},
+      {"LaMAR phone", lamar_phone_stream},
+  };
+  return all;
+}
+
+std::vector<unsigned char> encoded(const std::string& extension, const cv::Mat& image,
+                                   const std::vector<int>& parameters = {}) {
+  std::vector<unsigned char> bytes;
+  EXPECT_TRUE(cv::imencode(extension, image, bytes, parameters));
+  return bytes;
+}
+
+void write_bytes(const fs::path& path, const std::vector<unsigned char>& bytes) {
+  write_file(path, std::string(bytes.begin(), bytes.end()));
+}
+
+// An 8x8 BMP whose header claims 60000 x 60000 pixels, beyond OpenCV's limit: cv::imread throws.
+std::vector<unsigned char> bmp_claiming_a_huge_size() {
+  std::vector<unsigned char> bytes = encoded(".bmp", cv::Mat(8, 8, CV_8U, cv::Scalar(7)));
+  for (size_t offset : {18u, 22u})  // BITMAPINFOHEADER width, height: int32 little-endian
+    for (int k = 0; k < 4; ++k) bytes[offset + k] = (60000 >> (8 * k)) & 0xFF;
+  return bytes;
+}
+
+struct Damage {
+  std::string what;
+  std::function<void(const fs::path& file, const cv::Mat& stored)> apply;
+  std::string message;  // in the error, after the file's name
+};
+
+const std::vector<Damage>& damages() {
+  static const std::vector<Damage> all = {
+      {"truncated PNG",
+       [](const fs::path& f, const cv::Mat& image) {
+         std::vector<unsigned char> bytes = encoded(".png", image);
+         bytes.resize(bytes.size() / 2);
+         write_bytes(f, bytes);
+       },
+       "cannot decode image"},
+      // libjpeg decodes a JPEG cut short with a warning only, the missing rows grey.
+      {"truncated JPEG",
+       [](const fs::path& f, const cv::Mat& image) {
+         std::vector<unsigned char> bytes = encoded(".jpg", image);
+         bytes.resize(bytes.size() * 2 / 3);
+         write_bytes(f, bytes);
+       },
+       "JPEG cut short"},
+      {"zero-byte file", [](const fs::path& f, const cv::Mat&) { write_file(f, ""); },
+       "empty file"},
+      {"a file that is not an image",
+       [](const fs::path& f, const cv::Mat&) { write_file(f, "P5\nnot an image\n"); },
+       "cannot decode image"},
+      {"missing file", [](const fs::path& f, const cv::Mat&) { fs::remove(f); }, "no such image"},
+      {"image of another size",
+       [](const fs::path& f, const cv::Mat& image) {
+         cv::Mat half;
+         cv::resize(image, half, image.size() / 2);
+         ASSERT_TRUE(cv::imwrite(f.string(), half));
+       },
+       "80x48"},
+      {"image of another kind (colour among grey, grey among colour)",
+       [](const fs::path& f, const cv::Mat& image) {
+         cv::Mat other;
+         cv::cvtColor(image, other,
+                      image.channels() == 1 ? cv::COLOR_GRAY2BGR : cv::COLOR_BGR2GRAY);
+         ASSERT_TRUE(cv::imwrite(f.string(), other));
+       },
+       "-channel image, the first"},
+      // IMREAD_GRAYSCALE would scale it to 8 bits without a word.
+      {"16-bit image",
+       [](const fs::path& f, const cv::Mat& image) {
+         cv::Mat deep;
+         image.convertTo(deep, image.channels() == 1 ? CV_16UC1 : CV_16UC3, 257.0);
+         ASSERT_TRUE(cv::imwrite(f.string(), deep));
+       },
+       "16-bit image, but a bag holds 8-bit mono8"},
+      // cv::imread throws on it; uncaught, the converter aborted and left OUT.bag.tmp.
+      {"header claiming 60000x60000 pixels",
+       [](const fs::path& f, const cv::Mat&) { write_bytes(f, bmp_claiming_a_huge_size()); },
+       "cannot decode image"},
+  };
+  return all;
+}
+
+TEST(Converters, CompleteStreamHasOneMessagePerFrameOnEveryTopic) {
+  for (const StreamKind& kind : streams()) {
+    SCOPED_TRACE(kind.what);
+    TempDir dir("test_convert");
+    const fs::path bag = dir.path() / "out.bag";
+    const StreamCase stream = kind.make(dir.path(), bag);
+    std::string output;
+    ASSERT_EQ(run(stream.command, &output), 0) << output;
+    EXPECT_FALSE(fs::exists(bag.string() + ".tmp"));
+    EXPECT_EQ(stamps_by_topic(bag.string()), stream.complete);
+  }
+}
+
+TEST(Converters, DamagedFrameInTheMiddleFailsNamingTheFileAndLeavesNoBag) {
+  for (const StreamKind& kind : streams()) {
+    for (const Damage& damage : damages()) {
+      SCOPED_TRACE(kind.what + ": " + damage.what);
+      TempDir dir("test_convert");
+      const fs::path bag = dir.path() / "out.bag";
+      const StreamCase stream = kind.make(dir.path(), bag);
+      damage.apply(stream.frame, stream.stored);
+      std::string output;
+      EXPECT_EQ(run(stream.command, &output), 1) << output;
+      // "error: <file>: <message>", or from LaMAR "error: <images.txt>:<line>: " and the file.
+      EXPECT_TRUE(contains(
+          output, "error: " + (stream.listed.empty() ? stream.frame.string() : stream.listed)));
+      EXPECT_TRUE(contains(output, stream.frame.string()));
+      EXPECT_TRUE(contains(output, damage.message));
+      EXPECT_TRUE(no_bag(bag));
+    }
+  }
+}
+
+// The JPEG end test on the encodings a camera writes: every prefix of a file is refused, the whole
+// file is taken (with bytes after its end too), and what is taken decodes as cv::imread does.
+TEST(BagWriting, JpegCutShortIsRefused) {
+  const cv::Mat grey = kitti_rendering().left_images[0];
+  cv::Mat colour;
+  cv::cvtColor(grey, colour, cv::COLOR_GRAY2BGR);
+  colour.col(7).setTo(cv::Scalar(0, 0, 255));
+  const std::vector<std::pair<std::string, std::vector<unsigned char>>> jpegs = {
+      {"baseline grey", encoded(".jpg", grey)},
+      {"baseline colour", encoded(".jpg", colour)},
+      {"progressive", encoded(".jpg", colour, {cv::IMWRITE_JPEG_PROGRESSIVE, 1})},
+      {"restart markers", encoded(".jpg", colour, {cv::IMWRITE_JPEG_RST_INTERVAL, 2})},
+  };
+  TempDir dir("test_convert");
+  for (const auto& [what, bytes] : jpegs) {
+    SCOPED_TRACE(what);
+    EXPECT_TRUE(jpeg_reaches_end(bytes));
+    std::vector<unsigned char> trailing = bytes;
+    trailing.insert(trailing.end(), {0x00, 0x12, 0xFF});
+    EXPECT_TRUE(jpeg_reaches_end(trailing));
+    int taken = 0;
+    for (size_t n = 0; n < bytes.size(); ++n)
+      taken += jpeg_reaches_end(std::vector<unsigned char>(bytes.begin(), bytes.begin() + n));
+    EXPECT_EQ(taken, 0);
+
+    const fs::path file = dir.path() / "image.jpg";
+    write_bytes(file, bytes);
+    cv::Mat mono8;
+    int channels = 0;
+    std::string error;
+    ASSERT_TRUE(read_mono8(file.string(), &mono8, &channels, &error)) << error;
+    EXPECT_EQ(channels, what == "baseline grey" ? 1 : 3);
+    EXPECT_TRUE(same_image(mono8, cv::imread(file.string(), cv::IMREAD_GRAYSCALE)));
+    write_bytes(file, std::vector<unsigned char>(bytes.begin(), bytes.end() - 2));  // no EOI
+    EXPECT_FALSE(read_mono8(file.string(), &mono8, &channels, &error));
+    EXPECT_TRUE(contains(error, file.string() + ": JPEG cut short"));
+  }
 }
 
 }  // namespace

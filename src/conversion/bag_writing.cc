@@ -5,10 +5,13 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include <cv_bridge/cv_bridge.h>
 #include <Eigen/Geometry>
 #include <geometry_msgs/PoseStamped.h>
+#include <opencv2/imgcodecs.hpp>
 #include <rosbag/exceptions.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_msgs/TFMessage.h>
@@ -167,6 +170,68 @@ void BagOutput::write_tf_static(const ros::Time& stamp,
   (*latched)["callerid"] = callerid;
   (*latched)["latching"] = "1";
   bag_.write("/tf_static", stamp, statics, latched);
+}
+
+bool read_mono8(const std::string& path, cv::Mat* mono8, int* channels, std::string* error) {
+  auto failed = [&](const std::string& reason) {
+    *error = path + ": " + reason;
+    return false;
+  };
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return failed("no such image");
+  if (!std::filesystem::is_regular_file(path, ec)) return failed("not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return failed("cannot read");
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)),
+                                   std::istreambuf_iterator<char>());
+  if (bytes.empty()) return failed("empty file, not an image");
+  // OpenCV's own test for a JPEG, whatever the file's extension.
+  const bool jpeg = bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+  if (jpeg && !jpeg_reaches_end(bytes))
+    return failed("JPEG cut short (no end-of-image marker): cannot decode image");
+  try {
+    // Decoded in its own depth and colours first, so that depth and channels can be checked;
+    // a colour file is decoded again in grey, so that its pixels are exactly what
+    // IMREAD_GRAYSCALE gives (libjpeg's grey output, not cvtColor's).
+    const cv::Mat stored = cv::imdecode(bytes, cv::IMREAD_ANYCOLOR | cv::IMREAD_ANYDEPTH);
+    if (stored.empty()) return failed("cannot decode image");
+    if (stored.depth() != CV_8U)
+      return failed(std::to_string(8 * stored.elemSize1()) + "-bit " +
+                    (stored.depth() >= CV_32F ? "floating-point " : "") +
+                    "image, but a bag holds 8-bit mono8: convert it to 8 bits first");
+    *channels = stored.channels();
+    *mono8 = stored.channels() == 1 ? stored : cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
+    if (mono8->empty()) return failed("cannot decode image");
+  } catch (const cv::Exception& e) {
+    // A header that claims a size beyond OpenCV's limits (CV_IO_MAX_IMAGE_PIXELS) throws.
+    return failed("cannot decode image (" + e.err + ")");
+  }
+  return true;
+}
+
+bool jpeg_reaches_end(const std::vector<unsigned char>& b) {
+  const size_t n = b.size();
+  if (n < 4 || b[0] != 0xFF || b[1] != 0xD8) return false;
+  auto standalone = [](unsigned char m) { return m == 0x01 || (m >= 0xD0 && m <= 0xD7); };
+  size_t i = 2;  // after SOI
+  while (i + 1 < n) {
+    if (b[i] != 0xFF) return false;  // no marker where one must be
+    const unsigned char marker = b[i + 1];
+    if (marker == 0xFF) {  // fill byte
+      ++i;
+      continue;
+    }
+    i += 2;
+    if (marker == 0xD9) return true;   // EOI
+    if (standalone(marker)) continue;  // TEM, RSTn: no length
+    if (i + 2 > n) return false;
+    const size_t length = (static_cast<size_t>(b[i]) << 8) | b[i + 1];
+    if (length < 2) return false;
+    i += length;
+    if (marker == 0xDA)  // SOS: entropy-coded data follows, up to the next real marker
+      while (i + 1 < n && !(b[i] == 0xFF && b[i + 1] != 0x00 && !standalone(b[i + 1]))) ++i;
+  }
+  return false;
 }
 
 }  // namespace conversion

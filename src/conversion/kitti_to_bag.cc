@@ -1,12 +1,11 @@
 #include "hybrid_vo/conversion/kitti_to_bag.h"
 
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <sstream>
 
 #include <Eigen/Core>
-#include <opencv2/imgcodecs.hpp>
-#include <rosbag/exceptions.h>
 
 #include "hybrid_vo/conversion/bag_writing.h"
 #include "hybrid_vo/datasets/kitti.h"
@@ -35,21 +34,16 @@ bool check_images(const std::string& sequence_dir, int camera, size_t frames,
   const std::string dir = (fs::path(sequence_dir) / ("image_" + std::to_string(camera))).string();
   const int count = datasets::count_kitti_images(sequence_dir, camera);
   if (count < 0) return fail(error, located(dir, 0, "no such directory"));
-  if (static_cast<size_t>(count) != frames)
-    return fail(error, located(dir, 0,
-                               std::to_string(count) + " images for " + std::to_string(frames) +
-                                   " timestamps in " + times_path));
+  // Each frame's file first, so that a missing one is named; then the count, for extra files.
   for (size_t k = 0; k < frames; ++k) {
     const std::string path = datasets::kitti_image_path(sequence_dir, camera, k);
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) return fail(error, located(path, 0, "no such image"));
   }
-  return true;
-}
-
-bool read_gray(const std::string& path, cv::Mat* image, std::string* error) {
-  *image = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (image->empty()) return fail(error, located(path, 0, "cannot decode image"));
+  if (static_cast<size_t>(count) != frames)
+    return fail(error, located(dir, 0,
+                               std::to_string(count) + " images for " + std::to_string(frames) +
+                                   " timestamps in " + times_path));
   return true;
 }
 
@@ -143,19 +137,29 @@ bool convert_kitti(const KittiBagOptions& options, std::string* error, KittiBagS
   try {
     out.write_tf_static(t0, statics, "/hybrid_vo_kitti_to_bag");
     cv::Mat first;
+    int first_channels = 0;
     for (size_t k = 0; k < times.size(); ++k) {
       const ros::Time stamp(options.start_time + times[k]);
       for (int camera = 0; camera < (options.stereo ? 2 : 1); ++camera) {
         const std::string path = datasets::kitti_image_path(dir, camera, k);
         cv::Mat image;
-        if (!read_gray(path, &image, error)) return false;
-        if (first.empty()) first = image;
+        int channels = 0;
+        if (!read_mono8(path, &image, &channels, error)) return false;
+        if (first.empty()) {
+          first = image;
+          first_channels = channels;
+        }
         if (image.size() != first.size())
           return fail(error, located(path, 0,
                                      "image is " + std::to_string(image.cols) + "x" +
                                          std::to_string(image.rows) + ", the first was " +
                                          std::to_string(first.cols) + "x" +
                                          std::to_string(first.rows)));
+        // A colour frame among grey ones is another camera's (KITTI's image_2/3), not this one.
+        if (channels != first_channels)
+          return fail(error, located(path, 0,
+                                     std::to_string(channels) + "-channel image, the first was " +
+                                         std::to_string(first_channels) + "-channel"));
         const datasets::KittiProjection& P = camera == 0 ? calibration.P0 : calibration.P1;
         PinholeCamera K = P.camera;
         K.width = image.cols;
@@ -176,7 +180,8 @@ bool convert_kitti(const KittiBagOptions& options, std::string* error, KittiBagS
       summary->height = first.rows;
       summary->poses_path = poses_path;
     }
-  } catch (const rosbag::BagException& e) {
+  } catch (const std::exception& e) {
+    // rosbag's, and any other (cv_bridge, allocation): the BagOutput still removes its file.
     return fail(error, located(options.out_bag, 0, e.what()));
   }
   return true;

@@ -1,12 +1,10 @@
 #include "hybrid_vo/conversion/lamar_to_bag.h"
 
 #include <algorithm>
+#include <exception>
 #include <map>
 #include <set>
 #include <sstream>
-
-#include <opencv2/imgcodecs.hpp>
-#include <rosbag/exceptions.h>
 
 #include "hybrid_vo/conversion/bag_writing.h"
 #include "hybrid_vo/datasets/lamar.h"
@@ -175,12 +173,23 @@ bool convert_lamar(const LamarBagOptions& options, std::string* error, LamarBagS
     out.write_tf_static(t0, static_transforms(session, streams, frames, t0),
                         "/hybrid_vo_lamar_to_bag");
     // session.images is in time order, so the bag is too.
+    std::vector<int> first_channels(streams.size(), 0);
     for (const auto& [i, k] : stream_of) {
       const datasets::LamarImage& image = session.images[i];
       const datasets::LamarSensor& sensor = *session.sensor(image.sensor_id);
       const datasets::CameraIntrinsics& c = sensor.intrinsics;
-      const cv::Mat gray = cv::imread(image.path, cv::IMREAD_GRAYSCALE);
-      if (gray.empty()) return fail(error, located(image.path, 0, "cannot decode image"));
+      cv::Mat gray;
+      int channels = 0;
+      std::string why;
+      if (!read_mono8(image.path, &gray, &channels, &why))
+        return fail(error, located(session.images_path, image.line, why));
+      // A phone's per-frame cameras may change size (sensors.txt says so), never their kind.
+      if (first_channels[k] == 0) first_channels[k] = channels;
+      if (channels != first_channels[k])
+        return fail(error, located(session.images_path, image.line,
+                                   image.path + ": " + std::to_string(channels) +
+                                       "-channel image, the first of " + streams[k].id + " was " +
+                                       std::to_string(first_channels[k]) + "-channel"));
       if (gray.cols != c.width || gray.rows != c.height)
         return fail(error, located(session.images_path, image.line,
                                    image.path + " is " + std::to_string(gray.cols) + "x" +
@@ -203,7 +212,8 @@ bool convert_lamar(const LamarBagOptions& options, std::string* error, LamarBagS
       }
     }
     if (!out.commit(error)) return false;
-  } catch (const rosbag::BagException& e) {
+  } catch (const std::exception& e) {
+    // rosbag's, and any other (cv_bridge, allocation): the BagOutput still removes its file.
     return fail(error, located(options.out_bag, 0, e.what()));
   }
   for (size_t k = 0; k < streams.size(); ++k) {

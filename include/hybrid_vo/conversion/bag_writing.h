@@ -1,8 +1,9 @@
 #pragma once
 
 // What every bag writer of ours shares (the renderer and the KITTI and LaMAR converters): topic
-// and frame names, camera_info, images, ground truth and latched static transforms, and an output
-// file that only appears under its name once it is complete.
+// and frame names, camera_info, images, ground truth and latched static transforms, an output
+// file that only appears under its name once it is complete, and input images read so that a
+// damaged one stops the conversion instead of going into the bag.
 //
 // Layout of a bag (the launch files rely on it):
 //   /camera/<name>/image_raw     sensor_msgs/Image mono8, frame camera_<name>_optical
@@ -84,6 +85,20 @@ class BagOutput {
   std::string path_, tmp_path_;
   bool committed_ = false;
 };
+
+// An image file on its way into a bag: false with "path: reason" for a missing or empty file,
+// one OpenCV cannot decode (or whose header claims a size OpenCV refuses), a JPEG cut short
+// (libjpeg only warns "Premature end of JPEG file" and fills the missing rows with grey), and
+// one of more than 8 bits per channel (IMREAD_GRAYSCALE would scale it down without a word).
+// *mono8 is what cv::imread(path, IMREAD_GRAYSCALE) gives (EXIF orientation applied, colour
+// turned grey by the decoder); *channels is 1 for a grey file and 3 for a colour one, so that a
+// converter can refuse a frame unlike the rest of its stream.
+bool read_mono8(const std::string& path, cv::Mat* mono8, int* channels, std::string* error);
+
+// True when JPEG bytes reach their end-of-image marker (bytes after it are allowed): marker
+// segments are skipped by their length, entropy-coded data up to the next marker that is neither
+// a stuffed 0xFF00 nor a restart marker.
+bool jpeg_reaches_end(const std::vector<unsigned char>& bytes);
 
 }  // namespace conversion
 }  // namespace hybrid_vo
