@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -236,6 +237,38 @@ TEST(StereoPoints, RenderedPairHasUnbiasedDisparities) {
   std::sort(errors.begin(), errors.end());
   EXPECT_LT(std::abs(errors[errors.size() / 2]), 0.1);                     // no bias
   EXPECT_LT(errors[3 * errors.size() / 4] - errors[errors.size() / 4], 0.5);  // sub-pixel
+  // Predicted disparities (a track's in the previous frame) start the search nearby: the same
+  // disparities where the prediction is a few pixels off; a wrong prediction (a far point
+  // predicted near, or none at all) falls back to the long way or is refused, never wrong.
+  const double fb = camera.fx * seq.options.baseline;
+  auto compare = [&](const std::vector<double>& predicted, int* same, int* wrong) {
+    std::vector<char> valid_predicted;
+    const std::vector<Eigen::Vector3d> Xp = stereo_points(
+        left.image, right.image, pixels, camera, seq.options.baseline, &valid_predicted, {},
+        predicted);
+    *same = *wrong = 0;
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      if (!valid_predicted[i]) continue;
+      const double difference = valid[i] ? std::abs(fb / X[i].z() - fb / Xp[i].z()) : 1e9;
+      if (difference < 0.05) ++*same;
+      else if (difference > 0.5) ++*wrong;
+    }
+  };
+  std::vector<double> predicted(pixels.size());
+  for (size_t i = 0; i < pixels.size(); ++i)
+    predicted[i] = valid[i] ? fb / X[i].z() + (i % 2 ? 3.0 : -3.0)
+                            : std::numeric_limits<double>::quiet_NaN();
+  int same = 0, wrong = 0;
+  compare(predicted, &same, &wrong);
+  EXPECT_GT(same, 9 * kept / 10);
+  EXPECT_LT(wrong, kept / 50 + 1);
+  for (size_t i = 0; i < pixels.size(); ++i) predicted[i] = i % 2 ? 200.0 : 0.0;
+  compare(predicted, &same, &wrong);
+  EXPECT_GT(same, 8 * kept / 10);
+  EXPECT_LT(wrong, kept / 50 + 1);
+  // Predictions of another length than the points are not used.
+  compare(std::vector<double>(3, 200.0), &same, &wrong);
+  EXPECT_EQ(same, kept);
   // A right image of another size: no points, no crash.
   const std::vector<Eigen::Vector3d> none = stereo_points(
       left.image, right.image(cv::Rect(0, 0, 100, 100)), pixels, camera, 0.1, &valid);

@@ -8,6 +8,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "hybrid_vo/frontend/gray_image.h"
+#include "hybrid_vo/frontend/lucas_kanade.h"
 
 namespace hybrid_vo {
 namespace {
@@ -21,38 +22,14 @@ float median_of(std::vector<float>* v) {
   return (*v)[v->size() / 2];
 }
 
-// Pyramidal Lucas-Kanade for the features `which` of `from` (in `from_pyramid`) into
-// `to_pyramid`. A short search (levels >= 0) starts at `to[i]` and spans `levels` levels above
-// full resolution; a long one (levels < 0) starts at the feature itself and spans all levels.
-// Writes `to` and `found` of those features.
+// The tracker's searches: lucas_kanade_search with its own window, levels and iterations.
 void search(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>& to_pyramid,
             const std::vector<cv::Point2f>& from, const std::vector<int>& which, int levels,
             const KltTrackerOptions& options, std::vector<cv::Point2f>* to,
             std::vector<char>* found) {
-  if (which.empty()) return;
-  std::vector<cv::Point2f> a, b;
-  a.reserve(which.size());
-  b.reserve(which.size());
-  for (int i : which) {
-    a.push_back(from[i]);
-    b.push_back((*to)[i]);
-  }
-  std::vector<uchar> status;
-  std::vector<float> error;
-  const cv::Size window(options.window_px, options.window_px);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
-                                  std::max(1, options.max_iterations), 0.01);
-  if (levels < 0) {
-    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, error, window,
-                             options.pyramid_levels, criteria);
-  } else {
-    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, error, window, levels,
-                             criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
-  }
-  for (size_t k = 0; k < which.size(); ++k) {
-    (*to)[which[k]] = b[k];
-    (*found)[which[k]] = status[k] != 0;
-  }
+  lucas_kanade_search(from_pyramid, to_pyramid, from, which, levels, options.pyramid_levels,
+                      cv::Size(options.window_px, options.window_px), options.max_iterations, to,
+                      found);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <opencv2/imgproc.hpp>
 
@@ -85,21 +86,34 @@ void VisualOdometry::restart() {
 }
 
 std::map<int64_t, Eigen::Vector3d> VisualOdometry::stereo_of(
-    const VisualOdometryInput& input, const cv::Mat& gray,
+    const VisualOdometryInput& input, const cv::Mat& gray, const std::vector<cv::Mat>* left_pyramid,
     const std::map<int64_t, Eigen::Vector2d>& points) const {
   // Stereo: metric 3D points of the frame's features, for the scale of this and the next motion.
   std::map<int64_t, Eigen::Vector3d> points3d;
   if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
     std::vector<int64_t> ids;
     std::vector<Eigen::Vector2d> pixels;
+    // A track's disparity in the keyframe (usually the previous frame) is where its search starts
+    // (descriptor features have no tracks: their ids are indices into one frame).
+    std::vector<double> predicted;
+    const double fx_baseline = keyframe_.camera.pinhole.fx * input.baseline_m;
+    const bool tracks = input.external.has_points ||
+                        options_.point_source == PointFeatureSource::kTracking;
     for (const auto& [id, p] : points) {
       ids.push_back(id);
       pixels.push_back(p);
+      const auto it = keyframe_.valid && tracks ? keyframe_.points3d.find(id)
+                                                : keyframe_.points3d.end();
+      predicted.push_back(it != keyframe_.points3d.end() ? fx_baseline / it->second.z()
+                                                          : std::numeric_limits<double>::quiet_NaN());
     }
     std::vector<char> valid;
-    const std::vector<Eigen::Vector3d> X = stereo_points(
-        gray, to_gray8(input.right_image), pixels, input.camera.pinhole, input.baseline_m, &valid,
-        options_.stereo);
+    const cv::Mat right = to_gray8(input.right_image);
+    const std::vector<Eigen::Vector3d> X =
+        left_pyramid ? stereo_points(*left_pyramid, right, pixels, input.camera.pinhole,
+                                     input.baseline_m, &valid, options_.stereo, predicted)
+                     : stereo_points(gray, right, pixels, input.camera.pinhole, input.baseline_m,
+                                     &valid, options_.stereo, predicted);
     for (size_t i = 0; i < ids.size(); ++i)
       if (valid[i]) points3d[ids[i]] = X[i];
   }
@@ -191,7 +205,11 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     stereo_job = worker_->submit([&] {
       if (skip_stereo) return;
       const auto stereo_start = std::chrono::steady_clock::now();
-      points3d = stereo_of(input, gray, tracking ? klt_points() : points);
+      // The KLT tracker's pyramid of this image serves when its window and levels suffice.
+      const bool reuse = tracking && options_.klt.window_px >= options_.stereo.window_px &&
+                         options_.klt.pyramid_levels >= options_.stereo.pyramid_levels;
+      points3d = stereo_of(input, gray, reuse ? &klt_.pyramid() : nullptr,
+                           tracking ? klt_points() : points);
       times.stereo_ms = ms_since(stereo_start);
     });
   }

@@ -26,8 +26,10 @@ using evaluation::median;
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
-            << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]\n"
-               "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt).\n"
+            << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
+               " [--stereo]\n"
+               "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
+               "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction. Default preset\n"
                "  hybrid+junc.\n";
@@ -43,6 +45,7 @@ int run(int argc, char** argv) {
   const std::string dir = argv[1];
   int frames = -1;
   std::string preset = "hybrid+junc";
+  bool stereo = false;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -51,6 +54,13 @@ int run(int argc, char** argv) {
     else if (a == "--sequential") o.concurrent = false;
     else if (a == "--lbd") o.track_lines = false;
     else if (a == "--no-predict") o.klt.predict_motion = false;
+    else if (a == "--stereo") stereo = true;
+    else if (a == "--stereo-window" && i + 1 < argc) o.stereo.window_px = std::atoi(argv[++i]);
+    else if (a == "--stereo-levels" && i + 1 < argc) o.stereo.pyramid_levels = std::atoi(argv[++i]);
+    else if (a == "--stereo-predicted-levels" && i + 1 < argc)
+      o.stereo.predicted_pyramid_levels = std::atoi(argv[++i]);
+    else if (a == "--stereo-iterations" && i + 1 < argc)
+      o.stereo.max_iterations = std::atoi(argv[++i]);
     else {
       usage(argv[0]);
       return 2;
@@ -76,27 +86,35 @@ int run(int argc, char** argv) {
     return 1;
   }
   if (frames < 0 || frames > available) frames = available;
-  std::vector<cv::Mat> images;
-  for (int i = 0; i < frames; ++i) {
-    images.push_back(cv::imread(datasets::kitti_image_path(dir, 0, i), cv::IMREAD_GRAYSCALE));
-    if (images.back().empty()) {
-      std::cerr << datasets::kitti_image_path(dir, 0, i) << ": unreadable\n";
-      return 1;
-    }
+  if (stereo && !(calibration.baseline() > 0.0)) {
+    std::cerr << dir << "/calib.txt: --stereo needs P1\n";
+    return 1;
   }
+  std::vector<cv::Mat> images, right_images;
+  for (int i = 0; i < frames; ++i)
+    for (int camera = 0; camera < (stereo ? 2 : 1); ++camera) {
+      const std::string path = datasets::kitti_image_path(dir, camera, i);
+      (camera == 0 ? images : right_images).push_back(cv::imread(path, cv::IMREAD_GRAYSCALE));
+      if ((camera == 0 ? images : right_images).back().empty()) {
+        std::cerr << path << ": unreadable\n";
+        return 1;
+      }
+    }
   VisualOdometryInput input;
   input.camera.pinhole = calibration.P0.camera;
   input.camera.pinhole.width = images[0].cols;
   input.camera.pinhole.height = images[0].rows;
+  if (stereo) input.baseline_m = calibration.baseline();
 
   VisualOdometry vo(o);
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
-      cpu, line_matches, line_inliers, tracked, fallback;
+      stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, fallback;
   int ok = 0;
   double lines_sum = 0.0, inliers_sum = 0.0, searched_sum[2] = {0, 0}, fallback_sum[2] = {0, 0};
   for (int i = 0; i < frames; ++i) {
     input.stamp = 1.0 + 0.1 * i;
     input.image = images[i];
+    if (stereo) input.right_image = right_images[i];
     const double cpu_start = cpu_ms();
     const VisualOdometryResult r = vo.process(input);
     if (i == 0) continue;  // the first frame only initialises
@@ -110,8 +128,11 @@ int run(int argc, char** argv) {
     matching.push_back(r.stages.line_matching_ms);
     vps.push_back(r.stages.vps_ms);
     ransac.push_back(r.stages.ransac_ms);
+    stereo_ms.push_back(r.stages.stereo_ms);
     if (r.status != VoStatus::kOk) continue;
     ++ok;
+    if (stereo)
+      scaled.push_back(r.stereo_scale.status == StereoScaleStatus::kOk ? 1.0 : 0.0);
     line_matches.push_back(r.num_line_matches);
     line_inliers.push_back(r.estimate.estimate.num_line_inliers);
     lines_sum += r.num_line_matches;
@@ -134,6 +155,12 @@ int run(int argc, char** argv) {
               "line matching %.1f, VPs %.1f, RANSAC %.1f; CPU per frame %.1f\n",
               median(total), median(frontend), median(estimator), median(points), median(redetect),
               median(lines), median(matching), median(vps), median(ransac), median(cpu));
+  if (stereo) {
+    double n = 0.0;
+    for (double s : scaled) n += s;
+    std::printf("stereo: median %.1f ms (second thread); metric scale on %.0f of %d estimated pairs\n",
+                median(stereo_ms), n, ok);
+  }
   std::printf("median per estimated frame: line matches %.0f, line inliers %.0f, tracked %.0f, "
               "by LBD fallback %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
               median(line_matches), median(line_inliers), median(tracked), median(fallback),

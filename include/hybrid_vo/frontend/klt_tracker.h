@@ -49,6 +49,9 @@ class KltTracker {
   // Every feature of the last frame (tracked and newly detected) and its id.
   const std::vector<cv::Point2f>& points() const { return points_; }
   const std::vector<int64_t>& ids() const { return ids_; }
+  // The last frame's pyramid (cv::buildOpticalFlowPyramid with derivatives, window_px and
+  // pyramid_levels), so that matching the same image elsewhere (stereo) need not build it again.
+  const std::vector<cv::Mat>& pyramid() const { return previous_; }
 
  private:
   // Where each feature of the previous frame is searched for in the next one; false where there

@@ -152,9 +152,11 @@ class VisualOdometry {
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   };
 
-  // Stereo points of the frame's features by id (empty without a right image).
+  // Stereo points of the frame's features by id (empty without a right image). `left_pyramid`,
+  // when not null, is the left image's LK pyramid (the KLT tracker's).
   std::map<int64_t, Eigen::Vector3d> stereo_of(const VisualOdometryInput& input,
                                                const cv::Mat& gray,
+                                               const std::vector<cv::Mat>* left_pyramid,
                                                const std::map<int64_t, Eigen::Vector2d>& points) const;
   void make_keyframe(const VisualOdometryInput& input,
                      const std::map<int64_t, Eigen::Vector2d>& points,
