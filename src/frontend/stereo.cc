@@ -45,21 +45,22 @@ std::vector<Eigen::Vector3d> stereo_points(const std::vector<cv::Mat>& left_pyra
   // the image), the way back as far to the right. The offset is the predicted disparity or, the
   // long way, `start`.
   std::vector<cv::Point2f> from(n), to(n), back(n);
-  std::vector<float> offset(n, static_cast<float>(start));
+  std::vector<float> offset(n);
   std::vector<char> found(n, 0), back_found(n, 0), long_way(n, 1);
   std::vector<int> short_search, long_search;
+  auto start_from = [&](size_t i, double disparity, bool long_search_way) {
+    offset[i] = static_cast<float>(disparity);
+    long_way[i] = long_search_way;
+    to[i] = cv::Point2f(std::clamp(from[i].x - offset[i], 0.0f, std::max(0.0f, from[i].x)),
+                        from[i].y);
+    (long_search_way ? long_search : short_search).push_back(static_cast<int>(i));
+  };
   for (size_t i = 0; i < n; ++i) {
     from[i] = cv::Point2f(static_cast<float>(pixels[i].x()), static_cast<float>(pixels[i].y()));
     const double d = predicted ? predicted_disparities[i] : -1.0;
-    if (options.predicted_pyramid_levels >= 0 && std::isfinite(d) && d >= 0.0 && d < right.cols) {
-      offset[i] = static_cast<float>(d);
-      long_way[i] = 0;
-      short_search.push_back(static_cast<int>(i));
-    } else {
-      long_search.push_back(static_cast<int>(i));
-    }
-    to[i] = cv::Point2f(std::clamp(from[i].x - offset[i], 0.0f, std::max(0.0f, from[i].x)),
-                        from[i].y);
+    const bool usable =
+        options.predicted_pyramid_levels >= 0 && std::isfinite(d) && d >= 0.0 && d < right.cols;
+    start_from(i, usable ? d : start, !usable);
   }
   const int short_levels = std::min(options.predicted_pyramid_levels, options.pyramid_levels);
   auto search = [&](const std::vector<cv::Mat>& a, const std::vector<cv::Mat>& b,
@@ -70,14 +71,9 @@ std::vector<Eigen::Vector3d> stereo_points(const std::vector<cv::Mat>& left_pyra
   };
   search(left_pyramid, right_pyramid, from, short_search, short_levels, &to, &found);
   // What the short search lost (or found off its row: a wrong prediction) goes the long way.
-  for (int i : short_search) {
-    if (found[i] && std::abs(to[i].y - from[i].y) <= options.max_row_difference_px) continue;
-    offset[i] = static_cast<float>(start);
-    long_way[i] = 1;
-    to[i] = cv::Point2f(std::clamp(from[i].x - offset[i], 0.0f, std::max(0.0f, from[i].x)),
-                        from[i].y);
-    long_search.push_back(i);
-  }
+  for (int i : short_search)
+    if (!found[i] || std::abs(to[i].y - from[i].y) > options.max_row_difference_px)
+      start_from(i, start, true);
   std::sort(long_search.begin(), long_search.end());
   search(left_pyramid, right_pyramid, from, long_search, options.pyramid_levels, &to, &found);
 
