@@ -121,6 +121,11 @@ void VoNode::load_odometry_options() {
   o.use_vp_tracker = pnh_.param("vp_tracker", true);
   o.track_lines = pnh_.param("track_lines", false);
   o.klt.predict_motion = pnh_.param("klt_predict_motion", true);
+  o.klt.window_px = pnh_.param("klt_window_px", o.klt.window_px);
+  if (o.klt.window_px < 5) {
+    ROS_WARN("hybrid_vo: klt_window_px must be >= 5, using 21");
+    o.klt.window_px = 21;
+  }
   o.concurrent = pnh_.param("concurrent_frontend", true);
 }
 

@@ -11,6 +11,7 @@
 #include <ctime>
 #include <iostream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -46,6 +47,8 @@ int run(int argc, char** argv) {
   int frames = -1;
   std::string preset = "hybrid+junc";
   bool stereo = false;
+  double period_ms = 0.0;
+  int max_features = 1500;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -55,6 +58,11 @@ int run(int argc, char** argv) {
     else if (a == "--lbd") o.track_lines = false;
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--stereo") stereo = true;
+    else if (a == "--klt-window" && i + 1 < argc) o.klt.window_px = std::atoi(argv[++i]);
+    else if (a == "--klt-iterations" && i + 1 < argc) o.klt.max_iterations = std::atoi(argv[++i]);
+    else if (a == "--klt-levels" && i + 1 < argc) o.klt.pyramid_levels = std::atoi(argv[++i]);
+    else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
+    else if (a == "--period-ms" && i + 1 < argc) period_ms = std::atof(argv[++i]);
     else if (a == "--stereo-window" && i + 1 < argc) o.stereo.window_px = std::atoi(argv[++i]);
     else if (a == "--stereo-levels" && i + 1 < argc) o.stereo.pyramid_levels = std::atoi(argv[++i]);
     else if (a == "--stereo-predicted-levels" && i + 1 < argc)
@@ -71,7 +79,7 @@ int run(int argc, char** argv) {
     return 2;
   }
   // As config/kitti.yaml sets the node.
-  o.klt.max_features = o.features.points.max_features = 1500;
+  o.klt.max_features = o.features.points.max_features = max_features;
   o.estimator.vp_detection.min_inliers = 6;
 
   std::string error;
@@ -111,7 +119,11 @@ int run(int argc, char** argv) {
       stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, fallback;
   int ok = 0;
   double lines_sum = 0.0, inliers_sum = 0.0, searched_sum[2] = {0, 0}, fallback_sum[2] = {0, 0};
+  const auto run_start = std::chrono::steady_clock::now();
   for (int i = 0; i < frames; ++i) {
+    if (period_ms > 0.0)
+      std::this_thread::sleep_until(run_start + std::chrono::microseconds(
+                                                    static_cast<int64_t>(1000.0 * period_ms * i)));
     input.stamp = 1.0 + 0.1 * i;
     input.image = images[i];
     if (stereo) input.right_image = right_images[i];
