@@ -154,6 +154,7 @@ TEST(FinalRefinement, RefinedVpDirectionsBeatNoisyDetectedOnes) {
     }
     const RelativePose start = perturb(rng, s.truth, 0.5 * kDeg, 1.0 * kDeg);
     FinalRefinementOptions options;
+    options.vp_sigma_deg = 0.05;  // trusting the detected VPs
     options.refine_vp_directions = false;
     fixed_error += rotation_error(refine_relative_pose_ceres(kCamera, kCamera, s.points, s.vps,
                                                              s.lines, s.line_vp, start, options)
@@ -282,7 +283,8 @@ TEST(FinalRefinement, VanishingPointsAlonePinTheRotation) {
 TEST(FinalRefinement, LabelledLinesPullTheRotation) {
   std::mt19937_64 rng(5);
   FinalRefinementOptions lines_only;
-  lines_only.vp_weight = 0.0;  // no VP residuals: the rotation comes from the lines alone
+  lines_only.vp_sigma_deg = std::numeric_limits<double>::infinity();  // no VP residuals:
+  // the rotation comes from the lines alone
   for (int trial = 0; trial < 10; ++trial) {
     const Scene s = make_scene(rng, 0, 3, 60, 0.0);
     const RelativePose start = perturb(rng, s.truth, 2.0 * kDeg, 0.0);
@@ -295,7 +297,7 @@ TEST(FinalRefinement, LabelledLinesPullTheRotation) {
   }
   // With few noisy points, noiseless labelled lines improve the rotation.
   FinalRefinementOptions without_lines = lines_only;
-  without_lines.line_vp_weight = 0.0;
+  without_lines.line_vp_sigma_px = std::numeric_limits<double>::infinity();
   double with_error = 0.0, without_error = 0.0;
   std::normal_distribution<double> n;
   for (int trial = 0; trial < 20; ++trial) {
@@ -361,7 +363,7 @@ TEST(FinalRefinement, BadInputFailsOrIsSkippedNeverNaN) {
 
   // Non-finite options.
   FinalRefinementOptions bad_options;
-  bad_options.vp_weight = nan;
+  bad_options.vp_sigma_deg = nan;
   r = refine_relative_pose_ceres(kCamera, kCamera, s.points, s.vps, s.lines, s.line_vp, start,
                                  bad_options);
   EXPECT_FALSE(r.success);
@@ -443,6 +445,59 @@ TEST(FinalRefinement, Timing) {
               << " ms, min " << ms.front() << " ms, " << double(iterations) / runs
               << " iterations\n";
   }
+}
+
+}  // namespace
+}  // namespace hybrid_vo
+
+namespace hybrid_vo {
+namespace {
+
+// A VP prior (e.g. a tracked direction) pins the rotation through image 2's segments: with few
+// noisy points, an exact prior in camera 1 and exact segments in image 2, the rotation about every
+// axis the VPs span is the prior's, also when camera 1's segments are left out (includes_view1).
+TEST(FinalRefinement, VpPriorPullsTheRotation) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n;
+  double with_error = 0.0, without_error = 0.0;
+  for (int trial = 0; trial < 20; ++trial) {
+    Scene s = make_scene(rng, 30, 3, 60, 0.0);
+    for (PointMatch& m : s.points) {
+      m.x1 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
+      m.x2 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
+    }
+    RefinementData data;
+    data.points = s.points;
+    data.vps = s.vps;
+    data.lines = s.lines;
+    data.line_vp = s.line_vp;
+    const RelativePose start = perturb(rng, s.truth, 1.0 * kDeg, 2.0 * kDeg);
+    FinalRefinementOptions options;
+    options.point_sigma_px = 2.0;
+    options.line_vp_sigma_px = 0.1;
+    const FinalRefinementResult without =
+        refine_relative_pose_ceres(kCamera, kCamera, s.points, {}, {}, {}, start, options);
+    for (const VpMatch& v : s.vps) {
+      VpPrior prior;
+      prior.valid = true;
+      prior.direction = v.d1;
+      const double sigma = 0.01 * kDeg;
+      prior.covariance = sigma * sigma * (Eigen::Matrix3d::Identity() - v.d1 * v.d1.transpose());
+      prior.includes_view1 = true;
+      data.vp_priors.push_back(prior);
+    }
+    const FinalRefinementResult with =
+        refine_relative_pose_ceres(kCamera, kCamera, data, start, options);
+    ASSERT_TRUE(with.success);
+    EXPECT_EQ(with.num_vp_priors, 3);
+    EXPECT_EQ(with.num_line_residuals, 60);  // image 2 only
+    with_error += rotation_error(with.pose.R, s.truth.R);
+    without_error += rotation_error(without.pose.R, s.truth.R);
+  }
+  std::cout << "mean rotation error, 30 points at 2 px: with exact VP priors "
+            << with_error / 20 / kDeg << " deg, points alone " << without_error / 20 / kDeg
+            << " deg\n";
+  EXPECT_LT(with_error, 0.1 * without_error);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <ceres/ceres.h>
 
 #include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/geometry/vp_covariance.h"
 #include "hybrid_vo/geometry/vp_distance.h"
 
 namespace hybrid_vo {
@@ -42,8 +43,8 @@ Matrix43 quaternion_plus_jacobian(const double* q) {
 class PointSampsonCost final : public ceres::SizedCostFunction<1, 4, 3> {
  public:
   PointSampsonCost(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector2d& w1,
-                   const Eigen::Vector2d& w2)
-      : p_(p), q_(q), w1_(w1), w2_(w2) {}
+                   const Eigen::Vector2d& w2, double scale)
+      : p_(p), q_(q), w1_(w1), w2_(w2), scale_(scale) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
@@ -63,12 +64,12 @@ class PointSampsonCost final : public ceres::SizedCostFunction<1, 4, 3> {
       if (jacobians && jacobians[1]) Eigen::Map<Eigen::RowVector3d>(jacobians[1]).setZero();
       return true;
     }
-    const double sqrt_D = std::sqrt(D);
+    const double sqrt_D = std::sqrt(D) / scale_;  // the scale folds into the normaliser
     residuals[0] = C / sqrt_D;
     if (!jacobians) return true;
     // dr/dE = G = (dC/dE - C / (2 D) dD/dE) / sqrt(D) with dC/dE = q p^T and
     // dD/dE = 2 (W2 a p^T + q (W1 b)^T), i.e. G = u p^T + q v^T.
-    const double k = C / D;
+    const double k = C / D;  // D unscaled: C / D is scale-free
     const Eigen::Vector3d u = (q_ - k * wa) / sqrt_D, v = (-k / sqrt_D) * wb;
     // <G, [e]x R> = e . vee(G R^T) with vee(M) = (M21 - M12, M02 - M20, M10 - M01) and
     // vee(a b^T) = b x a. With G R^T = u (R p)^T + q (R v)^T: dE = [dt]x R gives dr/dt, and
@@ -89,6 +90,7 @@ class PointSampsonCost final : public ceres::SizedCostFunction<1, 4, 3> {
  private:
   Eigen::Vector3d p_, q_;    // K1^-1 x1, K2^-1 x2
   Eigen::Vector2d w1_, w2_;  // (1 / fx^2, 1 / fy^2) of each camera
+  double scale_;             // 1 / sigma in pixels
 };
 
 // VP error given the rotation (paper Sec. 4): s (R d1 - d2) when the sign is known, else
@@ -221,6 +223,61 @@ class LineFreeVpCost final : public ceres::SizedCostFunction<1, 4, 3> {
   double weight_;
 };
 
+// A prior on a VP's free direction d (camera 1): its gnomonic coordinates y = B^T d / (p^T d)
+// around the prior direction p, whitened by the prior's covariance in that tangent plane
+// (r = L y with L^T L = (B^T S B)^-1), so that |r|^2 is the Mahalanobis distance.
+class VpPriorCost final : public ceres::SizedCostFunction<2, 3> {
+ public:
+  VpPriorCost(const Eigen::Vector3d& p, const Eigen::Matrix<double, 3, 2>& B,
+              const Eigen::Matrix2d& L)
+      : p_(p), B_(B), L_(L) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Map<const Eigen::Vector3d> d(parameters[0]);
+    const double c = p_.dot(d);
+    Eigen::Map<Eigen::Vector2d> r(residuals);
+    if (!(std::abs(c) > 1e-12)) {  // 90 degrees off: no pull, rather than an infinite one
+      r.setZero();
+      if (jacobians && jacobians[0])
+        Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>>(jacobians[0]).setZero();
+      return true;
+    }
+    const Eigen::Vector2d y = B_.transpose() * d / c;
+    r = L_ * y;
+    if (jacobians && jacobians[0]) {
+      Eigen::Map<Eigen::Matrix<double, 2, 3, Eigen::RowMajor>> J(jacobians[0]);
+      J = L_ * (B_.transpose() / c - y * p_.transpose() / c);
+    }
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d p_;
+  Eigen::Matrix<double, 3, 2> B_;
+  Eigen::Matrix2d L_;
+};
+
+// Whitening of a prior's covariance in the tangent plane of its direction: false when it is not
+// positive definite there.
+bool prior_whitening(const VpPrior& prior, Eigen::Vector3d* p, Eigen::Matrix<double, 3, 2>* B,
+                     Eigen::Matrix2d* L) {
+  if (!prior.valid || !all_finite(prior.direction) || !all_finite(prior.covariance) ||
+      !(prior.direction.norm() > 0.0))
+    return false;
+  *p = prior.direction.normalized();
+  *B = tangent_basis(*p);
+  const Eigen::Matrix2d S = B->transpose() * prior.covariance * *B;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(0.5 * (S + S.transpose()));
+  if (eigen.info() != Eigen::Success || !(eigen.eigenvalues()(0) > 0.0)) return false;
+  // L = D^-1/2 V^T: L^T L = V D^-1 V^T = S^-1.
+  *L = eigen.eigenvalues().cwiseSqrt().cwiseInverse().asDiagonal() *
+       eigen.eigenvectors().transpose();
+  return all_finite(*L);
+}
+
+bool usable_sigma(double sigma) { return sigma > 0.0 && std::isfinite(sigma); }
+
 bool is_rotation(const Eigen::Matrix3d& R) {
   return all_finite(R) && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
          R.determinant() > 0.0;
@@ -237,16 +294,34 @@ FinalRefinementResult refine_relative_pose_ceres(
     const std::vector<PointMatch>& points, const std::vector<VpMatch>& vps,
     const std::vector<LineMatch>& lines, const std::vector<int>& line_vp,
     const RelativePose& initial, const FinalRefinementOptions& options) {
+  RefinementData data;
+  data.points = points;
+  data.vps = vps;
+  data.lines = lines;
+  data.line_vp = line_vp;
+  return refine_relative_pose_ceres(camera1, camera2, data, initial, options);
+}
+
+FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
+                                                 const PinholeCamera& camera2,
+                                                 const RefinementData& data,
+                                                 const RelativePose& initial,
+                                                 const FinalRefinementOptions& options) {
+  const std::vector<PointMatch>& points = data.points;
+  const std::vector<VpMatch>& vps = data.vps;
+  const std::vector<LineMatch>& lines = data.lines;
+  const std::vector<int>& line_vp = data.line_vp;
   FinalRefinementResult result;
   result.pose = initial;
   const double t_norm = initial.t.norm();
   if (t_norm > 0.0 && std::isfinite(t_norm)) result.pose.t /= t_norm;
   if (!camera1.valid() || !camera2.valid() || !is_rotation(initial.R) || !all_finite(initial.t))
     return result;
-  const double scales[] = {options.point_loss_px, options.vp_loss_deg, options.vp_weight,
-                           options.line_vp_weight};
-  for (double value : scales)
-    if (!std::isfinite(value)) return result;
+  // A NaN sigma or scale is a caller's mistake, unlike an infinite sigma (the modality left out).
+  const double values[] = {options.point_sigma_px, options.line_vp_sigma_px, options.vp_sigma_deg,
+                           options.point_loss_px,  options.line_vp_loss_px,  options.vp_loss_deg};
+  for (double value : values)
+    if (std::isnan(value)) return result;
   // Points need a direction to start t from.
   if (!points.empty() && !(t_norm > 0.0 && std::isfinite(t_norm))) return result;
 
@@ -256,15 +331,27 @@ FinalRefinementResult refine_relative_pose_ceres(
   double q[4] = {rotation.x(), rotation.y(), rotation.z(), rotation.w()};
   double t[3] = {result.pose.t.x(), result.pose.t.y(), result.pose.t.z()};
 
-  // Loss functions are shared by their residuals and outlive the problem.
-  const double f_vp = 0.5 * (camera1.mean_focal() + camera2.mean_focal());
-  const double vp_scale = options.vp_weight * f_vp;
-  std::unique_ptr<ceres::LossFunction> point_loss, vp_loss, line_loss;
-  if (options.point_loss_px > 0.0) point_loss.reset(new ceres::CauchyLoss(options.point_loss_px));
-  if (options.vp_loss_deg > 0.0 && vp_scale > 0.0)
-    vp_loss.reset(new ceres::CauchyLoss(vp_scale * options.vp_loss_deg * kDegree));
-  if (options.point_loss_px > 0.0 && options.line_vp_weight > 0.0)
-    line_loss.reset(new ceres::CauchyLoss(options.line_vp_weight * options.point_loss_px));
+  const bool use_vps = usable_sigma(options.vp_sigma_deg);
+  const bool use_lines = usable_sigma(options.line_vp_sigma_px);
+  const double vp_scale = use_vps ? 1.0 / (options.vp_sigma_deg * kDegree) : 0.0;
+  const double line_scale = use_lines ? 1.0 / options.line_vp_sigma_px : 0.0;
+  // Losses on whitened residuals, at each modality's threshold in its sigmas; shared by the
+  // modality's residuals (points: per point sigma, so per distinct sigma), outliving the problem.
+  std::vector<std::unique_ptr<ceres::LossFunction>> losses;
+  auto cauchy = [&](double threshold, double sigma) -> ceres::LossFunction* {
+    if (!(threshold > 0.0) || !std::isfinite(threshold) || !usable_sigma(sigma)) return nullptr;
+    losses.emplace_back(new ceres::CauchyLoss(threshold / sigma));
+    return losses.back().get();
+  };
+  ceres::LossFunction* line_loss = cauchy(options.line_vp_loss_px, options.line_vp_sigma_px);
+  ceres::LossFunction* vp_loss = cauchy(options.vp_loss_deg, options.vp_sigma_deg);
+  std::vector<std::pair<double, ceres::LossFunction*>> point_losses;
+  auto point_loss = [&](double sigma) {
+    for (const auto& [s, loss] : point_losses)
+      if (s == sigma) return loss;
+    point_losses.emplace_back(sigma, cauchy(options.point_loss_px, sigma));
+    return point_losses.back().second;
+  };
 
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -274,13 +361,17 @@ FinalRefinementResult refine_relative_pose_ceres(
 
   const Eigen::Vector2d w1(1.0 / (camera1.fx * camera1.fx), 1.0 / (camera1.fy * camera1.fy));
   const Eigen::Vector2d w2(1.0 / (camera2.fx * camera2.fx), 1.0 / (camera2.fy * camera2.fy));
-  for (const PointMatch& m : points) {
-    if (!all_finite(m.x1) || !all_finite(m.x2)) continue;
+  const bool per_point = data.point_sigma_px.size() == points.size();
+  for (size_t i = 0; i < points.size(); ++i) {
+    const PointMatch& m = points[i];
+    const double sigma = per_point ? data.point_sigma_px[i] : options.point_sigma_px;
+    if (!all_finite(m.x1) || !all_finite(m.x2) || !usable_sigma(sigma)) continue;
     if (result.num_point_residuals == 0)
       problem.AddParameterBlock(t, 3, new ceres::SphereManifold<3>);
     problem.AddResidualBlock(new PointSampsonCost(homogeneous(camera1.normalize(m.x1)),
-                                                  homogeneous(camera2.normalize(m.x2)), w1, w2),
-                             point_loss.get(), q, t);
+                                                  homogeneous(camera2.normalize(m.x2)), w1, w2,
+                                                  1.0 / sigma),
+                             point_loss(sigma), q, t);
     ++result.num_point_residuals;
   }
 
@@ -294,7 +385,7 @@ FinalRefinementResult refine_relative_pose_ceres(
   // residual would count them twice and is dropped).
   std::vector<std::vector<int>> labelled(vps.size());
   std::vector<int> count1(vps.size(), 0), count2(vps.size(), 0);
-  if (options.line_vp_weight > 0.0) {
+  if (use_lines) {
     for (size_t i = 0; i < lines.size() && i < line_vp.size(); ++i) {
       const int k = line_vp[i];
       if (k < 0 || k >= static_cast<int>(vps.size()) || !vp_ok[k]) continue;
@@ -304,41 +395,55 @@ FinalRefinementResult refine_relative_pose_ceres(
     }
   }
   std::vector<Eigen::Vector3d> directions(vps.size());
-  int free_vps = 0;
+  int free_vps = 0, prior_rows = 0;
   const Eigen::Matrix3d K1 = camera1.K(), K2 = camera2.K();
   for (size_t k = 0; k < vps.size(); ++k) {
     if (!vp_ok[k]) continue;
     const Eigen::Vector3d d1 = vps[k].d1.normalized(), d2 = vps[k].d2.normalized();
-    if (options.refine_vp_directions && count1[k] >= 2 && count2[k] >= 2) {
-      directions[k] = d1;
+    // A prior needs image 2's segments to carry it to R; camera 1's are in it already or not.
+    Eigen::Vector3d prior_direction;
+    Eigen::Matrix<double, 3, 2> prior_basis;
+    Eigen::Matrix2d prior_whitener;
+    const bool prior = k < data.vp_priors.size() && count2[k] >= 2 &&
+                       prior_whitening(data.vp_priors[k], &prior_direction, &prior_basis,
+                                       &prior_whitener);
+    if (prior || (options.refine_vp_directions && count1[k] >= 2 && count2[k] >= 2)) {
+      directions[k] = prior ? prior_direction : d1;
       problem.AddParameterBlock(directions[k].data(), 3, new ceres::SphereManifold<3>);
       ++free_vps;
+      if (prior) {
+        problem.AddResidualBlock(new VpPriorCost(prior_direction, prior_basis, prior_whitener),
+                                 nullptr, directions[k].data());
+        ++result.num_vp_priors;
+        prior_rows += 2;
+      }
+      const bool skip_view1 = prior && data.vp_priors[k].includes_view1;
       for (int i : labelled[k]) {
         for (const bool second : {false, true}) {
+          if (!second && skip_view1) continue;
           const LineSegment& segment = second ? lines[i].s2 : lines[i].s1;
           if (!usable_segment(segment)) continue;
           problem.AddResidualBlock(
-              new LineFreeVpCost(second ? K2 : K1, segment, second, options.line_vp_weight),
-              line_loss.get(), q, directions[k].data());
+              new LineFreeVpCost(second ? K2 : K1, segment, second, line_scale), line_loss, q,
+              directions[k].data());
           ++result.num_line_residuals;
         }
       }
       continue;
     }
-    if (vp_scale > 0.0) {
-      problem.AddResidualBlock(new VpAngleCost(d1, d2, vps[k].sign_known, vp_scale),
-                               vp_loss.get(), q);
+    if (use_vps) {
+      problem.AddResidualBlock(new VpAngleCost(d1, d2, vps[k].sign_known, vp_scale), vp_loss, q);
       ++result.num_vp_residuals;
     }
     for (int i : labelled[k]) {
       if (usable_segment(lines[i].s2)) {
-        problem.AddResidualBlock(new LineVpCost(K2, lines[i].s2, d1, false, options.line_vp_weight),
-                                 line_loss.get(), q);
+        problem.AddResidualBlock(new LineVpCost(K2, lines[i].s2, d1, false, line_scale),
+                                 line_loss, q);
         ++result.num_line_residuals;
       }
       if (usable_segment(lines[i].s1)) {
-        problem.AddResidualBlock(new LineVpCost(K1, lines[i].s1, d2, true, options.line_vp_weight),
-                                 line_loss.get(), q);
+        problem.AddResidualBlock(new LineVpCost(K1, lines[i].s1, d2, true, line_scale),
+                                 line_loss, q);
         ++result.num_line_residuals;
       }
     }
@@ -348,8 +453,8 @@ FinalRefinementResult refine_relative_pose_ceres(
   // At least five residual rows, and no fewer independent ones (a VP's three rows have rank two)
   // than free parameters: three for R, two more for t when points are used, two per free VP.
   const int parameters = (result.num_point_residuals > 0 ? 5 : 3) + 2 * free_vps;
-  const int ceres_rows =
-      result.num_point_residuals + 3 * result.num_vp_residuals + result.num_line_residuals;
+  const int ceres_rows = result.num_point_residuals + 3 * result.num_vp_residuals +
+                         result.num_line_residuals + prior_rows;
   const int rows = ceres_rows - result.num_vp_residuals;
   if (ceres_rows < 5 || rows < parameters) return result;
 

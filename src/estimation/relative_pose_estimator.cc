@@ -1,11 +1,15 @@
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "hybrid_problem.h"
 #include "hybrid_vo/geometry/cheirality.h"
+#include "hybrid_vo/geometry/vp_covariance.h"
+#include "hybrid_vo/geometry/vp_distance.h"
 #include "hybrid_ransac.h"
 #include "model_scorer.h"
 
@@ -78,41 +82,180 @@ void orient_by_inliers(const HybridProblem& problem, const ModelScorer& scorer, 
   orient_translation_by_majority(pose->R, &pose->t, view);
 }
 
-// Ceres refinement on the inliers (paper Sec. 4, final step); kept unless it loses inliers.
+// The noise scale of every modality from its residuals under `pose` (ModalityScales).
+ModalityScales measure_scales(const HybridProblem& problem, const ModelScorer& scorer,
+                              const RelativePoseEstimatorOptions& options,
+                              const TwoViewMatches& matches, const RelativePose& pose) {
+  const ModalityScaleOptions& o = options.scales;
+  const double point_gate = o.inlier_multiple * options.ransac.point_threshold_px;
+  const double vp_gate = options.ransac.vp_threshold_deg * kDegree;
+  const double line_gate = o.inlier_multiple * o.line_threshold_px;
+  ModalityScales scales;
+  scales.point_px = scales.junction_px = o.default_fraction * options.ransac.point_threshold_px;
+  scales.line_vp_px = o.default_fraction * o.line_threshold_px;
+  scales.vp_deg = o.default_fraction * options.ransac.vp_threshold_deg;
+  if (!o.enabled) return scales;
+
+  std::vector<double> points, junctions, lines, vps;
+  const Eigen::Matrix3d F = scorer.fundamental(pose);
+  for (int i = 0; i < problem.num_pool(); ++i) {
+    if (problem.origin[i].source != PointSource::kPoint) continue;
+    const double r = std::sqrt(scorer.squared_sampson(F, i));
+    if (r <= point_gate) points.push_back(r);
+  }
+  for (size_t j = 0; j < problem.junction_px1.size(); ++j) {
+    const double r =
+        std::sqrt(scorer.squared_sampson(F, problem.junction_px1[j], problem.junction_px2[j]));
+    if (r <= point_gate) junctions.push_back(r);
+  }
+  // VPs within the VP threshold (a wrong VP is not a noisy one), and their labelled segments
+  // against the detected VP in each image.
+  std::vector<char> vp_inlier(problem.num_vps(), 0);
+  for (int k = 0; k < problem.num_vps(); ++k) {
+    const double a = scorer.vp_angle(pose.R, k);
+    if (a <= vp_gate) {
+      vps.push_back(a);
+      vp_inlier[k] = 1;
+    }
+  }
+  const Eigen::Matrix3d K1 = problem.camera1.K(), K2 = problem.camera2.K();
+  for (int i = 0; i < problem.num_lines(); ++i) {
+    const int k = problem.line_vp[i];
+    if (k < 0 || !vp_inlier[k] || !problem.line_valid[i]) continue;
+    const LineMatch& m = matches.lines[i];
+    for (const double r : {tardif_distance(m.s1, K1 * problem.d1[k]),
+                           tardif_distance(m.s2, K2 * problem.d2[k])})
+      if (r <= line_gate) lines.push_back(r);
+  }
+  if (static_cast<int>(points.size()) >= o.min_points) {
+    scales.num_points = static_cast<int>(points.size());
+    scales.point_px = std::max(o.min_point_px, robust_sigma(&points, 1));
+    scales.junction_px = scales.point_px;
+  }
+  if (static_cast<int>(junctions.size()) >= o.min_junctions) {
+    scales.num_junctions = static_cast<int>(junctions.size());
+    scales.junction_px = std::max(o.min_point_px, robust_sigma(&junctions, 1));
+  }
+  if (static_cast<int>(lines.size()) >= o.min_lines) {
+    scales.num_lines = static_cast<int>(lines.size());
+    scales.line_vp_px = std::max(o.min_line_px, robust_sigma(&lines, 1));
+  }
+  if (static_cast<int>(vps.size()) >= o.min_vps) {
+    scales.num_vps = static_cast<int>(vps.size());
+    scales.vp_deg = std::max(o.min_vp_deg, robust_sigma(&vps, 2) / kDegree);
+  }
+  return scales;
+}
+
+// The gate of a VP prior (RelativePoseEstimatorOptions::vp_prior_gate_chi2): the prior's
+// direction carried into camera 2 by the pair's rotation against the VP seen there, under the
+// prior's covariance, the rotation's, and that of image 2's VP: the VP scale and its fit to its
+// segments.
+double vp_prior_chi2(const HybridProblem& problem, const TwoViewMatches& matches,
+                     const ModalityScales& scales, const RelativePose& pose,
+                     const Eigen::Matrix3d& rotation_covariance, int k) {
+  const VpPrior& prior = matches.vp_priors[problem.vp_index[k]];
+  const Eigen::Vector3d predicted = pose.R * prior.direction.normalized();
+  std::vector<LineSegment> segments;
+  for (int i = 0; i < problem.num_lines(); ++i)
+    if (problem.line_vp[i] == k && problem.line_valid[i]) segments.push_back(matches.lines[i].s2);
+  const Eigen::Vector3d& d2 = problem.d2[k];
+  // The segments' fit alone is optimistic (segments are not exactly straight, nor exactly
+  // parallel in the scene): the pair's VP scale, measured under this rotation, adds what the fit
+  // does not see, and the rotation's own error with it.
+  const double sigma = scales.vp_deg * kDegree;
+  Eigen::Matrix3d observed = sigma * sigma * (Eigen::Matrix3d::Identity() - d2 * d2.transpose());
+  Eigen::Matrix3d fit;
+  if (vp_direction_covariance(problem.camera2.K(), segments, d2, scales.line_vp_px, &fit))
+    observed += fit;
+  // The prior carried into camera 2, with the rotation's own uncertainty: a left increment w
+  // moves R p by -[R p]x w.
+  const Eigen::Matrix3d J = -skew(predicted);
+  const Eigen::Matrix3d carried = pose.R * prior.covariance * pose.R.transpose() +
+                                  J * rotation_covariance * J.transpose();
+  return direction_chi2(predicted, d2, carried + observed,
+                        static_cast<bool>(problem.vp_sign_known[k]));
+}
+
+// Ceres refinement on the inliers (paper Sec. 4, final step), every residual weighted by its
+// modality's measured scale; kept unless it loses inliers. Then the VP priors: each is gated
+// against the rotation this pair's own data support (the refined pose and its covariance), and
+// those that pass pull a second refinement, which starts from the first.
 void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
                   const RelativePoseEstimatorOptions& options, const TwoViewMatches& matches,
                   RelativePoseEstimate* est) {
   std::vector<char> pool, vps;
   const int pool_before = scorer.pool_inliers(est->pose, &pool);
   scorer.vp_inliers(est->pose, &vps);
-  std::vector<PointMatch> points;
-  for (int i = 0; i < problem.num_pool(); ++i)
-    if (pool[i]) points.push_back({problem.px1[i], problem.px2[i]});
-  std::vector<VpMatch> inlier_vps;
-  std::vector<int> refined_index(problem.num_vps(), -1);
+  RefinementData data;
+  for (int i = 0; i < problem.num_pool(); ++i) {
+    if (!pool[i]) continue;
+    data.points.push_back({problem.px1[i], problem.px2[i]});
+    data.point_sigma_px.push_back(problem.origin[i].source == PointSource::kPoint
+                                      ? est->scales.point_px
+                                      : est->scales.junction_px);
+  }
+  std::vector<int> refined_index(problem.num_vps(), -1), internal_index;
   for (int k = 0; k < problem.num_vps(); ++k) {
     if (!vps[k]) continue;
-    refined_index[k] = static_cast<int>(inlier_vps.size());
-    inlier_vps.push_back({problem.d1[k], problem.d2[k], static_cast<bool>(problem.vp_sign_known[k])});
+    refined_index[k] = static_cast<int>(data.vps.size());
+    internal_index.push_back(k);
+    data.vps.push_back({problem.d1[k], problem.d2[k], static_cast<bool>(problem.vp_sign_known[k])});
   }
-  std::vector<LineMatch> lines;
-  std::vector<int> line_vp;
   for (int i = 0; i < problem.num_lines(); ++i) {
     const int k = problem.line_vp[i];
     if (k < 0 || refined_index[k] < 0) continue;
-    lines.push_back(matches.lines[i]);
-    line_vp.push_back(refined_index[k]);
+    data.lines.push_back(matches.lines[i]);
+    data.line_vp.push_back(refined_index[k]);
   }
-  const FinalRefinementResult r = refine_relative_pose_ceres(
-      problem.camera1, problem.camera2, points, inlier_vps, lines, line_vp, est->pose,
-      options.refinement);
-  if (!r.success) return;
-  std::vector<char> after;
-  if (scorer.pool_inliers(r.pose, &after) < 0.95 * pool_before) return;
-  est->pose = r.pose;
-  est->covariance = r.covariance;
-  est->covariance_valid = r.covariance_valid;
-  est->refined = true;
+  FinalRefinementOptions refinement = options.refinement;
+  refinement.point_sigma_px = est->scales.point_px;
+  refinement.line_vp_sigma_px = est->scales.line_vp_px;
+  refinement.vp_sigma_deg = est->scales.vp_deg;
+  // Outliers are what RANSAC called outliers, whatever the measured noise.
+  refinement.point_loss_px = options.ransac.point_threshold_px;
+  refinement.line_vp_loss_px = options.scales.line_threshold_px;
+  refinement.vp_loss_deg = options.ransac.vp_threshold_deg;
+  // However many point matches there are, their errors are not independent (KLT's errors
+  // correlate between neighbouring tracks; calibration and rolling shutter shift all of them),
+  // so together they carry at most the information of max_independent_points matches.
+  const double dependence = std::sqrt(
+      std::max(1.0, static_cast<double>(data.points.size()) /
+                        std::max(1.0, options.scales.max_independent_points)));
+  for (double& sigma : data.point_sigma_px) sigma *= dependence;
+  est->scales.point_dependence = dependence;
+  auto accept = [&](const FinalRefinementResult& r) {
+    std::vector<char> after;
+    if (!r.success || scorer.pool_inliers(r.pose, &after) < 0.95 * pool_before) return false;
+    est->pose = r.pose;
+    est->covariance = r.covariance;
+    est->covariance_valid = r.covariance_valid;
+    est->refined = true;
+    return true;
+  };
+  accept(refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose, refinement));
+
+  if (matches.vp_priors.size() != matches.vps.size() || data.vps.empty()) return;
+  data.vp_priors.assign(data.vps.size(), VpPrior());
+  bool any = false;
+  const Eigen::Matrix3d rotation_covariance = est->covariance_valid
+                                                  ? Eigen::Matrix3d(est->covariance.topLeftCorner<3, 3>())
+                                                  : Eigen::Matrix3d::Zero();
+  for (size_t j = 0; j < data.vps.size(); ++j) {
+    const int k = internal_index[j];
+    const int input = problem.vp_index[k];
+    if (!matches.vp_priors[input].valid) continue;
+    const double chi2 =
+        vp_prior_chi2(problem, matches, est->scales, est->pose, rotation_covariance, k);
+    est->vp_prior_chi2[input] = chi2;
+    if (!(chi2 <= options.vp_prior_gate_chi2)) continue;
+    data.vp_priors[j] = matches.vp_priors[input];
+    est->vp_prior_used[input] = 1;
+    any = true;
+  }
+  if (any && !accept(refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose,
+                                                refinement)))
+    std::fill(est->vp_prior_used.begin(), est->vp_prior_used.end(), 0);
 }
 
 }  // namespace
@@ -187,6 +330,8 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
     est.total_ms = ms_since(start);
     return est;
   };
+  est.vp_prior_chi2.assign(matches.vps.size(), std::numeric_limits<double>::quiet_NaN());
+  est.vp_prior_used.assign(matches.vps.size(), 0);
   if (!camera1.valid() || !camera2.valid()) return finish(EstimationStatus::kInvalidInput);
 
   // A preset only sees the data its solvers use, so that point-only baselines stay point-only in
@@ -229,6 +374,7 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
   if (scorer.pool_inliers(est.pose, &pool) < options.min_point_inliers)
     return finish(EstimationStatus::kNoModel);
 
+  est.scales = measure_scales(problem, scorer, options, matches, est.pose);
   if (options.final_refinement) {
     const auto refine_start = std::chrono::steady_clock::now();
     refine_final(problem, scorer, options, matches, &est);

@@ -9,10 +9,37 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hybrid_vo/geometry/rotation.h"
+#include "hybrid_vo/geometry/vp_covariance.h"
 #include "hybrid_vo/frontend/gray_image.h"
 
 namespace hybrid_vo {
 namespace {
+
+// The VPs of one image of a pair as tracker observations: each direction with the covariance of
+// its fit to that image's labelled segments (pixels, at `sigma_px` per segment) plus `vp_sigma_deg`
+// per axis, the pair's measured VP scale: the fit alone is optimistic (rendered corridor: the fit
+// says 0.02-0.1 degrees, the VPs are 0.05-0.3 degrees off the true axes).
+std::vector<VpObservation> vp_observations(const Eigen::Matrix3d& K, const TwoViewMatches& m,
+                                           bool second_image, double sigma_px,
+                                           double vp_sigma_deg) {
+  std::vector<std::vector<LineSegment>> segments(m.vps.size());
+  for (size_t i = 0; i < m.lines.size() && i < m.line_vp.size(); ++i)
+    if (m.line_vp[i] >= 0 && m.line_vp[i] < static_cast<int>(m.vps.size()))
+      segments[m.line_vp[i]].push_back(second_image ? m.lines[i].s2 : m.lines[i].s1);
+  std::vector<VpObservation> observations(m.vps.size());
+  for (size_t k = 0; k < m.vps.size(); ++k) {
+    observations[k].direction = second_image ? m.vps[k].d2 : m.vps[k].d1;
+    // Without a usable fit the covariance stays zero: the tracker's default sigma.
+    Eigen::Matrix3d fit;
+    if (!vp_direction_covariance(K, segments[k], observations[k].direction, sigma_px, &fit))
+      continue;
+    const Eigen::Vector3d d = observations[k].direction.normalized();
+    const double sigma = vp_sigma_deg * M_PI / 180.0;
+    observations[k].covariance =
+        fit + sigma * sigma * (Eigen::Matrix3d::Identity() - d * d.transpose());
+  }
+  return observations;
+}
 
 bool uses_vps(const RelativePoseEstimatorOptions& options) {
   for (const SolverInfo& info : solver_table())
@@ -52,15 +79,7 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
       klt_(options.klt),
       vp_tracker_(options.vp_tracker),
-      offset_filter_(options.stereo_offset) {
-  if (options_.use_vp_tracker) {
-    // The tracker feeds d1 from directions averaged over many frames: trust them as given (they
-    // pin the rotation to the tracked Manhattan frame, which stops rotational drift) rather than
-    // re-fitting each VP to this pair's segments.
-    options_.estimator.estimator.refinement.refine_vp_directions = false;
-    options_.estimator.estimator.refinement.vp_weight = options_.tracked_vp_weight;
-  }
-}
+      offset_filter_(options.stereo_offset) {}
 
 VisualOdometry::~VisualOdometry() = default;
 
@@ -320,12 +339,16 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     m.line_vp = vps.labels;
     if (options_.use_vp_tracker) {
       if (!tracker_seeded_) {
-        std::vector<Eigen::Vector3d> d1;
-        for (const VpMatch& v : m.vps) d1.push_back(v.d1);
-        vp_tracker_.update(keyframe_.R_wc, d1);
+        vp_tracker_.update(keyframe_.R_wc,
+                           vp_observations(keyframe_.camera.pinhole.K(), m, false,
+                                           options_.estimator.vp_detection.inlier_threshold_px /
+                                               3.0,
+                                           options_.estimator.estimator.ransac.vp_threshold_deg /
+                                               3.0));
         tracker_seeded_ = true;
       }
-      r.vp_track_ids = vp_tracker_.refine_matches(keyframe_.R_wc, &m.vps);
+      m.vp_priors = vp_tracker_.priors(keyframe_.R_wc, m.vps);
+      for (const VpPrior& prior : m.vp_priors) r.vp_track_ids.push_back(prior.track_id);
     }
   }
   times.vps_ms = ms_since(vps_start);
@@ -394,15 +417,23 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
   r.R_wc = R_wc_;
   r.centre = centre_;
-  if (options_.use_vp_tracker && !m.vps.empty()) {
-    std::vector<Eigen::Vector3d> d2;
-    std::vector<double> weights;
+  if (options_.use_vp_tracker) {
+    // Every estimated frame, also without VPs, so that misses count. Only the VPs the pose
+    // accepts, each with the covariance of its fit to image 2's segments at the pair's measured
+    // segment noise.
+    TwoViewMatches inliers;
+    inliers.lines = m.lines;
+    inliers.line_vp = m.line_vp;
+    std::vector<int> kept(m.vps.size(), -1);
     for (size_t k = 0; k < m.vps.size(); ++k) {
       if (k < est.vp_inliers.size() && !est.vp_inliers[k]) continue;
-      d2.push_back(m.vps[k].d2);
-      weights.push_back(1.0);
+      kept[k] = static_cast<int>(inliers.vps.size());
+      inliers.vps.push_back(m.vps[k]);
     }
-    vp_tracker_.update(R_wc_, d2, weights);
+    for (int& label : inliers.line_vp) label = label >= 0 ? kept[label] : -1;
+    r.vp_associations = vp_tracker_.update(
+        R_wc_, vp_observations(input.camera.pinhole.K(), inliers, true, est.scales.line_vp_px,
+                               est.scales.vp_deg));
   }
   make_keyframe(input, tracking ? klt_points() : points, std::move(current3d),
                 std::move(features));

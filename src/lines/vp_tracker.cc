@@ -5,10 +5,12 @@
 #include <numeric>
 #include <tuple>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/geometry/vp_covariance.h"
 
 namespace hybrid_vo {
 namespace {
@@ -42,6 +44,27 @@ double line_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
 }
 
+// The projector onto the plane orthogonal to unit d.
+Eigen::Matrix3d tangent_projector(const Eigen::Vector3d& d) {
+  return Eigen::Matrix3d::Identity() - d * d.transpose();
+}
+
+// A detection's covariance in the odometry frame, projected onto its tangent plane and floored.
+Eigen::Matrix3d observation_covariance(const VpObservation& o, const Eigen::Matrix3d& R,
+                                       const Eigen::Vector3d& world,
+                                       const VpTrackerOptions& options) {
+  const Eigen::Matrix3d P = tangent_projector(world);
+  const double floor = std::pow(std::max(options.min_sigma_deg, 0.0) * kDeg, 2);
+  Eigen::Matrix3d C;
+  if (o.covariance.isZero(0.0)) {
+    const double sigma = std::max(options.default_sigma_deg, options.min_sigma_deg) * kDeg;
+    C = sigma * sigma * P;
+  } else {
+    C = P * R * o.covariance * R.transpose() * P;
+  }
+  return 0.5 * (C + C.transpose()) + floor * P;
+}
+
 // Greedy one-to-one association by smallest angle within `gate` (radians): for the handful of
 // VPs per frame this matches the optimal assignment whenever the VPs are further apart than
 // twice the gate, which a VP detector guarantees. `usable[j]` marks the candidate targets.
@@ -73,7 +96,37 @@ std::vector<int> associate(const std::vector<Eigen::Vector3d>& observations,
   return target_of;
 }
 
+// Kalman update of a track with a detection z (unit, odometry frame) of covariance C: both in
+// the tangent plane of the track's direction, where the gnomonic coordinates of z are the
+// innovation. Returns false (track unchanged) when the innovation covariance is singular.
+bool fuse(VpTrack* track, const Eigen::Vector3d& z, const Eigen::Matrix3d& C) {
+  const Eigen::Vector3d& d = track->direction;
+  const Eigen::Vector3d w = d.dot(z) >= 0.0 ? z : Eigen::Vector3d(-z);
+  const Eigen::Matrix<double, 3, 2> B = tangent_basis(d);
+  const Eigen::Vector2d y = B.transpose() * w / d.dot(w);
+  const Eigen::Matrix2d P = B.transpose() * track->covariance * B;
+  const Eigen::Matrix2d S = P + B.transpose() * C * B;
+  const Eigen::FullPivLU<Eigen::Matrix2d> lu(S);
+  if (!lu.isInvertible()) return false;
+  const Eigen::Matrix2d K = P * lu.inverse();
+  const Eigen::Vector3d next = (d + B * (K * y)).normalized();
+  Eigen::Matrix2d P_next = (Eigen::Matrix2d::Identity() - K) * P;
+  P_next = 0.5 * (P_next + P_next.transpose());
+  if (!all_finite(next) || !all_finite(P_next)) return false;
+  // The new tangent plane differs from the old by the (tiny) correction: re-project onto it.
+  const Eigen::Matrix3d projector = tangent_projector(next);
+  track->direction = next;
+  track->covariance = projector * B * P_next * B.transpose() * projector;
+  return true;
+}
+
 }  // namespace
+
+double VpTrack::sigma_deg() const {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(0.5 *
+                                                             (covariance + covariance.transpose()));
+  return std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff())) / kDeg;
+}
 
 VpTracker::VpTracker(const VpTrackerOptions& options) : options_(options) {}
 
@@ -83,31 +136,33 @@ const VpTrack* VpTracker::find(int id) const {
   return nullptr;
 }
 
-std::vector<int> VpTracker::update(const Eigen::Matrix3d& R_world_from_camera,
-                                   const std::vector<Eigen::Vector3d>& directions,
-                                   const std::vector<double>& weights) {
-  const size_t n = directions.size();
-  std::vector<int> ids(n, -1);
-  if (!is_rotation(R_world_from_camera)) return ids;
-  if (!weights.empty() && weights.size() != n) return ids;
+std::vector<VpAssociation> VpTracker::update(const Eigen::Matrix3d& R_world_from_camera,
+                                             const std::vector<VpObservation>& observations) {
+  const size_t n = observations.size();
+  std::vector<VpAssociation> result(n);
+  if (!is_rotation(R_world_from_camera)) return result;
+  ++frame_;
 
-  // Observations in the odometry frame.
+  // Observations in the odometry frame with their covariances.
   std::vector<Eigen::Vector3d> world(n, Eigen::Vector3d::Zero());
-  std::vector<double> w(n, 1.0);
+  std::vector<Eigen::Matrix3d> covariance(n, Eigen::Matrix3d::Zero());
   std::vector<char> valid(n, 0);
   for (size_t i = 0; i < n; ++i) {
-    if (!weights.empty()) w[i] = weights[i];
     Eigen::Vector3d unit;
-    if (!(std::isfinite(w[i]) && w[i] > 0.0) || !unit_direction(directions[i], &unit)) continue;
+    if (!unit_direction(observations[i].direction, &unit) ||
+        !all_finite(observations[i].covariance))
+      continue;
     world[i] = (R_world_from_camera * unit).normalized();
-    valid[i] = 1;
+    covariance[i] = observation_covariance(observations[i], R_world_from_camera, world[i],
+                                           options_);
+    valid[i] = all_finite(covariance[i]);
   }
 
-  // Age and decay every track; the decay lets later detections outweigh older ones.
-  const double memory = std::clamp(options_.memory, 0.0, 1.0);
+  // Predict: age, and the random walk that lets a track follow the odometry frame's drift.
+  const double q = std::pow(std::max(options_.process_noise_deg, 0.0) * kDeg, 2);
   for (VpTrack& track : tracks_) {
     ++track.age;
-    track.weight *= memory;
+    track.covariance += q * tangent_projector(track.direction);
   }
 
   std::vector<Eigen::Vector3d> track_directions;
@@ -118,34 +173,43 @@ std::vector<int> VpTracker::update(const Eigen::Matrix3d& R_world_from_camera,
   const std::vector<int> track_of =
       associate(world, valid, track_directions, usable, gate, &angles);
 
-  std::vector<char> hit(tracks_.size(), 0);
+  std::vector<char> fused(tracks_.size(), 0), gated(tracks_.size(), 0);
   for (size_t i = 0; i < n; ++i) {
     if (track_of[i] < 0) continue;
     VpTrack& track = tracks_[track_of[i]];
-    hit[track_of[i]] = 1;
-    // Sign-aligned recursive weighted mean: d <- normalise(W d + w s x), W <- W + w.
-    const double sign = track.direction.dot(world[i]) >= 0.0 ? 1.0 : -1.0;
-    const Eigen::Vector3d sum = track.weight * track.direction + w[i] * sign * world[i];
-    // sum . direction >= W > 0 after the sign alignment, so sum never vanishes; guard anyway
-    // against weights so large that it overflows.
-    if (all_finite(sum) && sum.norm() > 0.0 && std::isfinite(sum.norm())) {
-      track.direction = sum.normalized();
-      track.weight += w[i];
+    const double chi2 =
+        direction_chi2(track.direction, world[i], track.covariance + covariance[i], false);
+    result[i].track_id = track.id;
+    result[i].chi2 = chi2;
+    track.last_chi2 = chi2;
+    if (!(chi2 <= options_.gate_chi2) || !fuse(&track, world[i], covariance[i])) {
+      result[i].gated_out = true;
+      track.last_gate_passed = false;
+      gated[track_of[i]] = 1;
+      continue;
     }
+    fused[track_of[i]] = 1;
+    track.last_gate_passed = true;
+    track.gate_failures = 0;
     ++track.hits;
     track.misses = 0;
-    track.last_angle_deg = angles[i] / kDeg;
+    track.last_update = frame_;
     track.confident = track.hits >= options_.confirm_hits;
-    ids[i] = track.id;
   }
-  for (size_t j = 0; j < tracks_.size(); ++j)
-    if (!hit[j]) ++tracks_[j].misses;
+  for (size_t j = 0; j < tracks_.size(); ++j) {
+    if (gated[j]) {
+      ++tracks_[j].gate_failures;
+      ++tracks_[j].total_gate_failures;
+    }
+    if (!fused[j]) ++tracks_[j].misses;
+  }
 
-  // Unmatched observations, heaviest first, start tracks unless they duplicate a track (an
-  // existing one that a closer observation took, or one started earlier in this frame).
+  // Unmatched observations, most certain first, start tracks unless they duplicate a track (an
+  // existing one, also one whose gate they failed, or one started earlier in this frame).
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return w[a] > w[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return covariance[a].trace() < covariance[b].trace(); });
   for (const int i : order) {
     if (!valid[i] || track_of[i] >= 0) continue;
     bool duplicate = false;
@@ -158,32 +222,35 @@ std::vector<int> VpTracker::update(const Eigen::Matrix3d& R_world_from_camera,
     VpTrack track;
     track.id = next_id_++;
     track.direction = world[i];
+    track.covariance = covariance[i];
     track.hits = 1;
-    track.weight = w[i];
+    track.last_update = frame_;
     track.confident = track.hits >= options_.confirm_hits;
     tracks_.push_back(track);
-    ids[i] = track.id;
+    result[i].track_id = track.id;
   }
 
-  // Drop stale tracks; remove_if keeps the rest in creation order.
-  const int max_misses = options_.max_misses;
+  // Drop stale tracks and tracks that keep failing the gate; the rest stay in creation order.
+  const int max_misses = options_.max_misses, max_failures = options_.max_gate_failures;
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
-                               [max_misses](const VpTrack& t) { return t.misses > max_misses; }),
+                               [&](const VpTrack& t) {
+                                 return t.misses > max_misses ||
+                                        (max_failures > 0 && t.gate_failures >= max_failures);
+                               }),
                 tracks_.end());
-  return ids;
+  return result;
 }
 
-std::vector<int> VpTracker::refine_matches(const Eigen::Matrix3d& R_world_from_camera1,
-                                           std::vector<VpMatch>* matches) const {
-  if (matches == nullptr) return {};
-  const size_t n = matches->size();
-  std::vector<int> ids(n, -1);
-  if (!is_rotation(R_world_from_camera1)) return ids;
+std::vector<VpPrior> VpTracker::priors(const Eigen::Matrix3d& R_world_from_camera1,
+                                       const std::vector<VpMatch>& matches) const {
+  const size_t n = matches.size();
+  std::vector<VpPrior> priors(n);
+  if (!is_rotation(R_world_from_camera1)) return priors;
 
   std::vector<Eigen::Vector3d> world(n, Eigen::Vector3d::Zero()), d1(n, Eigen::Vector3d::Zero());
   std::vector<char> valid(n, 0);
   for (size_t i = 0; i < n; ++i) {
-    if (!unit_direction((*matches)[i].d1, &d1[i])) continue;
+    if (!unit_direction(matches[i].d1, &d1[i])) continue;
     world[i] = (R_world_from_camera1 * d1[i]).normalized();
     valid[i] = 1;
   }
@@ -197,17 +264,23 @@ std::vector<int> VpTracker::refine_matches(const Eigen::Matrix3d& R_world_from_c
   std::vector<double> angles;
   const std::vector<int> track_of = associate(world, valid, track_directions, confident, gate,
                                               &angles);
+  const double q = std::pow(std::max(options_.process_noise_deg, 0.0) * kDeg, 2);
   for (size_t i = 0; i < n; ++i) {
     if (track_of[i] < 0) continue;
     const VpTrack& track = tracks_[track_of[i]];
-    Eigen::Vector3d in_camera = R_world_from_camera1.transpose() * track.direction;
-    in_camera.normalize();
-    // Keep the old d1's sign: with sign_known, d2 = +R d1 must still hold.
-    if (in_camera.dot(d1[i]) < 0.0) in_camera = -in_camera;
-    (*matches)[i].d1 = in_camera;
-    ids[i] = track.id;
+    const Eigen::Matrix3d& R = R_world_from_camera1;
+    Eigen::Vector3d direction = (R.transpose() * track.direction).normalized();
+    // d1's sign: with sign_known, d2 = +R d1 must still hold for the prior's direction.
+    if (direction.dot(d1[i]) < 0.0) direction = -direction;
+    Eigen::Matrix3d covariance = R.transpose() * track.covariance * R;
+    covariance += q * tangent_projector(direction);
+    priors[i].valid = true;
+    priors[i].direction = direction;
+    priors[i].covariance = 0.5 * (covariance + covariance.transpose());
+    priors[i].includes_view1 = track.last_update == frame_;
+    priors[i].track_id = track.id;
   }
-  return ids;
+  return priors;
 }
 
 }  // namespace hybrid_vo

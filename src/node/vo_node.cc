@@ -1,5 +1,7 @@
 #include "hybrid_vo/node/vo_node.h"
 
+#include <cmath>
+
 #include <hybrid_vo/MotionEstimate.h>
 #include <hybrid_vo/VanishingPoints.h>
 #include <nav_msgs/Odometry.h>
@@ -257,6 +259,16 @@ void VoNode::record_result(const Frame& frame, const VisualOdometryResult& resul
       last_problem_ = std::string(to_string(result.status)) + ": " + result.message;
       ROS_WARN_THROTTLE(2.0, "hybrid_vo: %s", last_problem_.c_str());
     }
+  }
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    vp_tracks_ = vo_->vp_tracker().tracks();
+    const RelativePoseEstimate& est = result.estimate.estimate;
+    for (size_t k = 0; k < est.vp_prior_chi2.size() && k < est.vp_prior_used.size(); ++k) {
+      if (est.vp_prior_used[k]) ++vp_priors_used_;
+      else if (std::isfinite(est.vp_prior_chi2[k])) ++vp_priors_rejected_;
+    }
+    for (const VpAssociation& a : result.vp_associations) vp_track_gate_failures_ += a.gated_out;
   }
   if (result.stereo_scale_attempted && !result.scale_known) {
     std::lock_guard<std::mutex> lock(stats_mutex_);

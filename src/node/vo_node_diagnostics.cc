@@ -3,6 +3,7 @@
 // watchdog that tells "no images" from "images without camera_info".
 #include "hybrid_vo/node/vo_node.h"
 
+#include <cstdio>
 #include <initializer_list>
 #include <utility>
 
@@ -68,6 +69,7 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   }
   status.summary(level, summary);
   add_tracking(status);
+  add_vp_tracks(status);
   add_counters(status);
 }
 
@@ -104,6 +106,28 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("stereo (ms)", r.stages.stereo_ms);
   status.add("segments tracked", r.line_tracking.tracked);
   status.add("segments matched by descriptor", r.line_tracking.fallback);
+}
+
+void VoNode::add_vp_tracks(diagnostic_updater::DiagnosticStatusWrapper& status) const {
+  // The VP tracker: each track's uncertainty and gate, and how its priors fared in the estimator.
+  int confident = 0;
+  for (const VpTrack& track : vp_tracks_) {
+    confident += track.confident;
+    char key[64], value[160];
+    std::snprintf(key, sizeof(key), "VP track %d", track.id);
+    std::snprintf(value, sizeof(value),
+                  "sigma %.3f deg, hits %d, last chi2 %.2f (%s), gate failures %d in a row, %d "
+                  "in total%s",
+                  track.sigma_deg(), track.hits, track.last_chi2,
+                  track.last_gate_passed ? "passed" : "failed", track.gate_failures,
+                  track.total_gate_failures, track.confident ? "" : ", not yet confident");
+    status.add(key, value);
+  }
+  status.add("VP tracks", static_cast<int>(vp_tracks_.size()));
+  status.add("VP tracks confident", confident);
+  status.add("VP priors used", vp_priors_used_);
+  status.add("VP priors rejected by the gate", vp_priors_rejected_);
+  status.add("VP detections failing their track's gate", vp_track_gate_failures_);
 }
 
 void VoNode::add_counters(diagnostic_updater::DiagnosticStatusWrapper& status) const {

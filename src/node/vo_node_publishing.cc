@@ -204,6 +204,11 @@ void VoNode::publish_vanishing_points(const ros::Time& stamp, const VisualOdomet
     vp.hits = track.hits;
     vp.age = track.age;
     vp.confident = track.confident;
+    vp.sigma_deg = track.sigma_deg();
+    vp.last_chi2 = track.last_chi2;
+    vp.last_gate_passed = track.last_gate_passed;
+    vp.gate_failures = track.gate_failures;
+    vp.total_gate_failures = track.total_gate_failures;
     vps.vps.push_back(vp);
   }
   vps_pub_.publish(vps);

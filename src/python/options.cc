@@ -187,11 +187,16 @@ const OptionTable<TwoViewOptions>& estimator_option_table() {
         .add("junctions_min_angle_deg", FIELD(estimator.junctions.min_angle_deg),
              Range::kNonNegative)
         .add("final_refinement", FIELD(estimator.final_refinement))
-        .add("refinement_point_loss_px", FIELD(estimator.refinement.point_loss_px))
-        .add("refinement_vp_loss_deg", FIELD(estimator.refinement.vp_loss_deg))
-        .add("refinement_vp_weight", FIELD(estimator.refinement.vp_weight), Range::kNonNegative)
-        .add("refinement_line_vp_weight", FIELD(estimator.refinement.line_vp_weight),
-             Range::kNonNegative)
+        .add("scales_enabled", FIELD(estimator.scales.enabled))
+        .add("scales_min_points", FIELD(estimator.scales.min_points), Range::kNonNegative)
+        .add("scales_min_junctions", FIELD(estimator.scales.min_junctions), Range::kNonNegative)
+        .add("scales_min_lines", FIELD(estimator.scales.min_lines), Range::kNonNegative)
+        .add("scales_min_vps", FIELD(estimator.scales.min_vps), Range::kNonNegative)
+        .add("scales_inlier_multiple", FIELD(estimator.scales.inlier_multiple), Range::kPositive)
+        .add("scales_line_threshold_px", FIELD(estimator.scales.line_threshold_px),
+             Range::kPositive)
+        .add("scales_default_fraction", FIELD(estimator.scales.default_fraction), Range::kPositive)
+        .add("vp_prior_gate_chi2", FIELD(estimator.vp_prior_gate_chi2), Range::kNonNegative)
         .add("refinement_refine_vp_directions", FIELD(estimator.refinement.refine_vp_directions))
         .add("refinement_max_iterations", FIELD(estimator.refinement.max_iterations),
              Range::kNonNegative)

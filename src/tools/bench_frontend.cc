@@ -1,12 +1,15 @@
 // hybrid_vo_bench_frontend: the node's VisualOdometry on a KITTI sequence's left images, without
 // ROS, with the KITTI configuration (config/kitti.yaml). Images are read before the clock starts.
 // Prints per-stage medians, the process CPU time per frame (load-independent enough to compare
-// configurations on a shared machine) and the matches. Under
+// configurations on a shared machine) and the matches; with the sequence's ground truth
+// (<root>/poses/<name>.txt) also the accuracy, as hybrid_vo_eval_trajectory prints it for a
+// run through the node but without dropped frames, so that it does not depend on the load. Under
 // `valgrind --tool=callgrind --toggle-collect='hybrid_vo::VisualOdometry::process*'` with
 // --sequential it gives instruction counts per configuration.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cmath>
 #include <cstdlib>
 #include <ctime>
 #include <iostream>
@@ -14,11 +17,15 @@
 #include <thread>
 #include <vector>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <opencv2/imgcodecs.hpp>
 
 #include "hybrid_vo/datasets/kitti.h"
 #include "hybrid_vo/evaluation/statistics.h"
+#include "hybrid_vo/evaluation/trajectory.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/geometry/pose_error.h"
 
 namespace hybrid_vo {
 namespace {
@@ -49,6 +56,7 @@ int run(int argc, char** argv) {
   bool stereo = false;
   double period_ms = 0.0;
   int max_features = 1500;
+  bool verbose = false;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -62,6 +70,8 @@ int run(int argc, char** argv) {
     else if (a == "--klt-iterations" && i + 1 < argc) o.klt.max_iterations = std::atoi(argv[++i]);
     else if (a == "--klt-levels" && i + 1 < argc) o.klt.pyramid_levels = std::atoi(argv[++i]);
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
+    else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
+    else if (a == "--verbose") verbose = true;
     else if (a == "--period-ms" && i + 1 < argc) period_ms = std::atof(argv[++i]);
     else if (a == "--stereo-window" && i + 1 < argc) o.stereo.window_px = std::atoi(argv[++i]);
     else if (a == "--stereo-levels" && i + 1 < argc) o.stereo.pyramid_levels = std::atoi(argv[++i]);
@@ -114,6 +124,21 @@ int run(int argc, char** argv) {
   input.camera.pinhole.height = images[0].rows;
   if (stereo) input.baseline_m = calibration.baseline();
 
+  // Ground truth: <root>/poses/<name>.txt beside <root>/sequences/<name>.
+  std::vector<datasets::KittiPose> gt;
+  {
+    std::string trimmed = dir;
+    while (trimmed.size() > 1 && trimmed.back() == '/') trimmed.pop_back();
+    const size_t slash = trimmed.find_last_of('/');
+    const std::string name = trimmed.substr(slash + 1);
+    const std::string root = slash == std::string::npos ? "." : trimmed.substr(0, slash);
+    std::string ignored;
+    datasets::read_kitti_poses(root + "/../poses/" + name + ".txt", &gt, &ignored);
+  }
+  std::vector<double> pose_errors, rotation_nees;
+  evaluation::Trajectory estimate, truth;
+  auto frame_of = [](double stamp) { return static_cast<int>(std::lround((stamp - 1.0) / 0.1)); };
+
   VisualOdometry vo(o);
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
       stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, fallback;
@@ -129,6 +154,78 @@ int run(int argc, char** argv) {
     if (stereo) input.right_image = right_images[i];
     const double cpu_start = cpu_ms();
     const VisualOdometryResult r = vo.process(input);
+    if (static_cast<int>(gt.size()) > i) {
+      evaluation::StampedPose e, g;
+      e.stamp = g.stamp = input.stamp;
+      e.R = r.R_wc;
+      e.c = r.centre;
+      g.R = gt[i].R_wc;
+      g.c = gt[i].c_w;
+      estimate.push_back(e);
+      truth.push_back(g);
+      const int reference = frame_of(r.reference_stamp);
+      if (i > 0 && reference >= 0 && reference < i) {
+        double error = 180.0;
+        if (r.status == VoStatus::kOk) {
+          const datasets::KittiPose& a = gt[reference];
+          const datasets::KittiPose& b = gt[i];
+          const RelativePose truth_pose{b.R_wc.transpose() * a.R_wc,
+                                        b.R_wc.transpose() * (a.c_w - b.c_w)};
+          error = std::max(rotation_error(r.motion.R, truth_pose.R),
+                           translation_error(r.motion.t, truth_pose.t)) * 180.0 / M_PI;
+          // Whether the estimator's rotation covariance predicts its error: the normalised
+          // squared error, chi-square with 3 dof when it does.
+          if (r.estimate.estimate.covariance_valid) {
+            const Eigen::AngleAxisd aa(Eigen::Matrix3d(r.motion.R * truth_pose.R.transpose()));
+            const Eigen::Vector3d w = aa.angle() * aa.axis();
+            const Eigen::Matrix3d C = r.estimate.estimate.covariance.topLeftCorner<3, 3>();
+            rotation_nees.push_back(w.dot(C.ldlt().solve(w)));
+          }
+        }
+        pose_errors.push_back(error);
+      }
+    }
+    if (verbose) {
+      // Per frame: status, VPs and what became of their priors, and the tracks.
+      const RelativePoseEstimate& est = r.estimate.estimate;
+      std::printf("frame %d: %s, %d VPs (%d inliers), scales: point %.3f px, line %.3f px, VP "
+                  "%.4f deg (%d)",
+                  i, to_string(r.status), static_cast<int>(r.matches.vps.size()),
+                  est.num_vp_inliers, est.scales.point_px, est.scales.line_vp_px,
+                  est.scales.vp_deg, est.scales.num_vps);
+      for (size_t k = 0; k < est.vp_prior_chi2.size(); ++k)
+        if (std::isfinite(est.vp_prior_chi2[k]))
+          std::printf("; prior %zu chi2 %.2f %s", k, est.vp_prior_chi2[k],
+                      est.vp_prior_used[k] ? "used" : "rejected");
+      // With ground truth in a Manhattan world (the rendered corridor), the error of each VP seen
+      // in the current image: its angle to the nearest world axis.
+      if (static_cast<int>(gt.size()) > i) {
+        std::printf("\n   VP error to the nearest axis (deg):");
+        for (const VpMatch& v : r.matches.vps) {
+          const Eigen::Vector3d w = (gt[i].R_wc * v.d2).normalized().cwiseAbs();
+          std::printf(" %.3f", std::acos(std::min(1.0, w.maxCoeff())) * 180.0 / M_PI);
+        }
+      }
+      std::printf("\n   tracks:");
+      for (const VpTrack& t : vo.vp_tracker().tracks()) {
+        // In a Manhattan world: the track's angle to the nearest world axis (odometry = camera 0).
+        double axis_error = NAN;
+        if (!gt.empty()) {
+          const Eigen::Vector3d w = (gt[0].R_wc * t.direction).normalized().cwiseAbs();
+          axis_error = std::acos(std::min(1.0, w.maxCoeff())) * 180.0 / M_PI;
+        }
+        std::printf(" [%d: sigma %.4f, hits %d, chi2 %.2f%s, axis %.3f]", t.id, t.sigma_deg(),
+                    t.hits, t.last_chi2, t.last_gate_passed ? "" : " FAILED", axis_error);
+      }
+      if (static_cast<int>(gt.size()) > i)
+      {
+        const Eigen::AngleAxisd aa(Eigen::Matrix3d(r.R_wc.transpose() * gt[0].R_wc.transpose() *
+                                                   gt[i].R_wc));
+        std::printf("\n   orientation error %.3f deg about %.2f %.2f %.2f (camera)",
+                    aa.angle() * 180.0 / M_PI, aa.axis().x(), aa.axis().y(), aa.axis().z());
+      }
+      std::printf("\n");
+    }
     if (i == 0) continue;  // the first frame only initialises
     cpu.push_back(cpu_ms() - cpu_start);
     total.push_back(r.total_ms);
@@ -177,6 +274,19 @@ int run(int argc, char** argv) {
               "by LBD fallback %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
               median(line_matches), median(line_inliers), median(tracked), median(fallback),
               lines_sum > 0.0 ? inliers_sum / lines_sum : 0.0, lines_sum);
+  if (!pose_errors.empty()) {
+    const evaluation::TrajectoryErrors te =
+        evaluation::compare_trajectories(estimate, truth, !stereo, 0.01);
+    std::printf("accuracy: pairs %zu, AUC@5/10/20 %.2f / %.2f / %.2f, drift %.2f %% and %.3f "
+                "deg/100 m, ATE %.4f m (%s), RPE rotation %.4f deg\n",
+                pose_errors.size(), 100.0 * pose_auc(pose_errors, 5.0),
+                100.0 * pose_auc(pose_errors, 10.0), 100.0 * pose_auc(pose_errors, 20.0),
+                te.drift_trans_percent, te.drift_rot_deg_per_100m, te.ate,
+                stereo ? "metric" : "scale aligned", te.rpe_rot_deg);
+    if (!rotation_nees.empty())
+      std::printf("rotation NEES (3 if the covariance is right): median %.1f over %zu pairs\n",
+                  median(rotation_nees), rotation_nees.size());
+  }
   if (o.track_lines)
     std::printf("line inlier ratio (pooled): searched %.3f of %.0f, LBD fallback %.3f of %.0f\n",
                 searched_sum[1] / std::max(1.0, searched_sum[0]), searched_sum[0],

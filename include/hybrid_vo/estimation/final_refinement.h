@@ -11,35 +11,42 @@
 namespace hybrid_vo {
 
 // The final refinement of the hybrid estimator (paper Sec. 4; DESIGN.md "Estimation"): Ceres
-// minimises, over R and the unit t, the robust sum of
+// minimises, over R and the unit t, the robust sum of whitened residuals, each divided by the
+// standard deviation of its modality (ModalityScales: measured on the pair's own inliers), so
+// that a modality pulls the pose only as far as its accuracy allows:
 //  - point: the Sampson error of each point match in pixels, i.e. under F = K2^-T E K1^-1 on pixel
-//    coordinates (one row);
-//  - VP: the angle between d2 and R d1 as s * (R d1 - d2) when the sign is known, else as
-//    s * (d2 x R d1) (three rows of rank two, norm 2 sin(angle / 2) resp. |sin angle|, i.e. the
-//    angle for small angles), where s = vp_weight * f and f is the mean focal length of the two
-//    cameras: one radian counts as f pixels, the displacement of an image point near the
-//    principal point under a rotation by that angle;
+//    coordinates (one row), over its sigma (per match: points and junctions differ);
+//  - VP: the angle between d2 and R d1 as (R d1 - d2) when the sign is known, else as
+//    (d2 x R d1) (three rows of rank two, norm 2 sin(angle / 2) resp. |sin angle|, i.e. the angle
+//    for small angles), over vp_sigma;
 //  - line-to-VP: for a segment labelled with VP k, the orthogonal distance of Tardif 2009 in
 //    pixels (the distance of an endpoint to the line through the segment's midpoint and the VP)
 //    between the segment in image 2 and the VP predicted from image 1, K2 R d1_k, and between the
-//    segment in image 1 and the VP predicted from image 2, K1 R^T d2_k (one row per image, times
-//    line_vp_weight). Tardif's distance is in pixels and grows with the segment's length, so a
-//    long segment, whose direction is better known, weighs more. With refine_vp_directions, a VP
-//    with two or more labelled segments per image instead gets a free 3D direction d (camera 1):
-//    its segments are measured against K1 d and K2 R d, and its VP residual is dropped (the
-//    detected VP was fitted on those same segments).
-// Each residual has a Cauchy loss whose scale is given in the
-// residual's own unit (pixels or degrees) and is multiplied by the same weight as the residual,
-// so the weights do not move the point at which a residual counts as an outlier.
+//    segment in image 1 and the VP predicted from image 2, K1 R^T d2_k (one row per image), over
+//    line_vp_sigma. Tardif's distance grows with the segment's length, so a long segment, whose
+//    direction is better known, weighs more. With refine_vp_directions, a VP with two or more
+//    labelled segments per image instead gets a free 3D direction d (camera 1): its segments are
+//    measured against K1 d and K2 R d, and its VP residual is dropped (the detected VP was fitted
+//    on those same segments);
+//  - VP prior: a VP whose prior is given (RefinementData::vp_priors) and which has two or more
+//    labelled segments in image 2 always gets a free direction d, pulled towards the prior's
+//    direction by the prior's covariance (two whitened rows in its tangent plane); camera 1's
+//    segments are left out when the prior already holds them. The prior never fixes d.
+// The sigmas weight; they do not decide what is an outlier. Points, segments and VPs have a
+// Cauchy loss at their modality's inlier threshold (in its own unit, as RANSAC used it), so a
+// residual counts as an outlier where it did in RANSAC, whatever the measured noise. A prior has
+// none: it passed its gate (the estimator's chi-square test) before it got here, and a robust
+// loss would switch it off exactly when the drift it exists to correct has grown.
 struct FinalRefinementOptions {
-  double point_loss_px = 1.0;  // Cauchy scale of the point Sampson residuals, pixels; <= 0: none
-  double vp_loss_deg = 2.0;    // Cauchy scale of the VP residuals, degrees; <= 0: none
-  // Weight of a VP residual against a point residual: the VP residual is vp_weight * f * angle
-  // (f the mean focal length, see above), so 1 counts 1/f rad like 1 px of Sampson error.
-  double vp_weight = 1.0;
-  // Weight of a line-to-VP residual (Tardif's distance in pixels) against a point residual; its
-  // Cauchy scale is point_loss_px.
-  double line_vp_weight = 1.0;
+  // Standard deviations of the modalities. A sigma that is not finite and positive leaves its
+  // modality out.
+  double point_sigma_px = 1.0 / 3.0;
+  double line_vp_sigma_px = 1.0 / 3.0;
+  double vp_sigma_deg = 2.0 / 3.0;
+  // Cauchy scales (the inlier thresholds); <= 0: plain least squares for that modality.
+  double point_loss_px = 1.0;
+  double line_vp_loss_px = 2.0;
+  double vp_loss_deg = 2.0;
   // Refine the 3D direction of every VP with at least two labelled segments in each image from
   // those segments (image 1 against K1 d, image 2 against K2 R d), instead of trusting the
   // detected VP: the lines then constrain the rotation directly (paper Sec. 4, "lines carry it").
@@ -53,6 +60,16 @@ struct FinalRefinementOptions {
   double parameter_tolerance = 1e-8;
 };
 
+// The refinement's data: inliers of the estimate.
+struct RefinementData {
+  std::vector<PointMatch> points;      // point-like matches, pixels
+  std::vector<double> point_sigma_px;  // per point; empty: FinalRefinementOptions::point_sigma_px
+  std::vector<VpMatch> vps;
+  std::vector<VpPrior> vp_priors;      // per VP, or empty
+  std::vector<LineMatch> lines;        // segments labelled with a VP, pixels
+  std::vector<int> line_vp;            // per entry of `lines`: index into `vps`
+};
+
 struct FinalRefinementResult {
   // False when fewer than 5 residual rows (or fewer independent rows than free parameters, a VP
   // counting two) remain after skipping bad items, when the cameras, the options or the initial
@@ -64,22 +81,24 @@ struct FinalRefinementResult {
   // the unit translation (rank 5: nothing along t). It is sigma^2 (J^T J)^-1, J the Jacobian of
   // the weighted residuals at the optimum scaled by the Cauchy loss (sqrt(rho'), as Ceres does),
   // computed by ceres::Covariance (DENSE_SVD) in the manifolds' tangent spaces and mapped to
-  // [w, t]. sigma^2 = 2 * final_cost / (rows - 5) is the residual variance in px^2, rows
-  // counting two per VP (its three rows have rank two), so the caller need not know the noise
-  // level. With the Cauchy loss this sigma^2 is a little low for inliers (about 15 % at noise =
-  // half the loss scale) and high when gross outliers remain. Zero and covariance_valid = false
+  // [w, t]. sigma^2 = 2 * final_cost / (rows - parameters) is the variance of the whitened
+  // residuals, rows counting two per VP (its three rows have rank two): 1 when the sigmas are
+  // right, and it corrects them when they are not, so the caller need not know the noise level.
+  // With the Cauchy loss this sigma^2 is a little low for inliers (about 15 % at noise = half the
+  // loss scale) and high when gross outliers remain. Zero and covariance_valid = false
   // when not requested, when there is no point residual (t is then not estimated), when
   // rows <= 5, or when J is rank deficient (singular values below 1e-5 of the largest, e.g. for
   // data that cannot separate t from a rotation).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_valid = false;
-  double sigma2 = 0.0;  // the residual variance behind the covariance, px^2
+  double sigma2 = 0.0;  // the variance factor of the whitened residuals behind the covariance
   int iterations = 0;
-  double initial_cost = 0.0, final_cost = 0.0;  // Ceres' cost, 1/2 sum of the losses, px^2
+  double initial_cost = 0.0, final_cost = 0.0;  // Ceres' cost, 1/2 sum of the whitened losses
   // Residuals used: point matches, VP matches, and line-to-VP residuals (up to two per labelled
   // line, one per image).
   int num_point_residuals = 0, num_vp_residuals = 0, num_line_residuals = 0;
   int num_refined_vps = 0;  // VPs whose direction was refined from their segments
+  int num_vp_priors = 0;    // VPs pulled towards their prior
 };
 
 // Refines `initial` on the inliers. Bad items are skipped: non-finite points, VPs with a zero or
@@ -93,5 +112,12 @@ FinalRefinementResult refine_relative_pose_ceres(
     const std::vector<LineMatch>& lines,    // segments labelled with a VP, pixels
     const std::vector<int>& line_vp,        // per entry of `lines`: index into `vps`
     const RelativePose& initial, const FinalRefinementOptions& options = {});
+
+// The same with per-point sigmas and VP priors.
+FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
+                                                 const PinholeCamera& camera2,
+                                                 const RefinementData& data,
+                                                 const RelativePose& initial,
+                                                 const FinalRefinementOptions& options = {});
 
 }  // namespace hybrid_vo

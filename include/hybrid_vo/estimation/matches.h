@@ -27,6 +27,20 @@ struct VpMatch {
   bool sign_known = false;
 };
 
+// What is known about a VP match's direction in camera 1 before this pair, e.g. from a VP tracked
+// over earlier frames (VpTracker::priors): a prior, not a constraint. The estimator tests it
+// against the pair's point-supported rotation and, when it passes, the final refinement pulls the
+// VP's direction towards it with its covariance.
+struct VpPrior {
+  bool valid = false;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // camera 1, unit, with d1's sign
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // rad^2, in the tangent plane
+  // The prior already holds camera 1's own segments of this VP (the tracker fused them when this
+  // frame was the current one): the refinement then leaves them out instead of counting twice.
+  bool includes_view1 = false;
+  int track_id = -1;
+};
+
 // Everything the two-view estimator consumes besides the cameras and options.
 struct TwoViewMatches {
   std::vector<PointMatch> points;
@@ -34,6 +48,8 @@ struct TwoViewMatches {
   std::vector<VpMatch> vps;
   // Per line, the index of its VP in `vps`, or -1. Empty when there are no labels.
   std::vector<int> line_vp;
+  // Per VP match, an optional prior on its direction. Empty when there are none.
+  std::vector<VpPrior> vp_priors;
 };
 
 }  // namespace hybrid_vo

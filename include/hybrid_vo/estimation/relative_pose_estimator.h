@@ -10,6 +10,7 @@
 #include "hybrid_vo/estimation/derived_matches.h"
 #include "hybrid_vo/estimation/final_refinement.h"
 #include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/estimation/modality_scales.h"
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/geometry/pose.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
@@ -71,7 +72,14 @@ struct RelativePoseEstimatorOptions {
   bool use_endpoint_points = false;
   JunctionOptions junctions;
   bool final_refinement = true;
+  // The refinement's sigmas come from the pair's own inliers (ModalityScales) unless disabled;
+  // its other settings from `refinement`.
+  ModalityScaleOptions scales;
   FinalRefinementOptions refinement;
+  // A VP prior (TwoViewMatches::vp_priors) is used only when its direction, carried by the best
+  // RANSAC model's rotation, agrees with the VP seen in image 2: the squared Mahalanobis distance
+  // under both covariances must not exceed this (chi-square, 2 dof: 9.21 at 99 %).
+  double vp_prior_gate_chi2 = 9.21;
   // Below this many point-like inliers (and no inlier VP pair to fix the rotation), the best model
   // is not trusted and the status is kNoModel.
   int min_point_inliers = 5;
@@ -108,6 +116,13 @@ struct RelativePoseEstimate {
   std::vector<char> junction_inliers, endpoint_inliers;
   int num_point_inliers = 0, num_line_inliers = 0, num_vp_inliers = 0;
   int num_junction_inliers = 0, num_endpoint_inliers = 0;
+
+  // The noise of each modality, measured on the best model's inliers; the refinement's sigmas.
+  ModalityScales scales;
+  // Per input VP match: the gate's squared Mahalanobis distance of its prior (NaN without a
+  // prior or when the VP is not an inlier) and whether the refinement used the prior.
+  std::vector<double> vp_prior_chi2;
+  std::vector<char> vp_prior_used;
 
   std::array<SolverStatistics, kNumSolvers> solvers{};
   SolverId best_solver = SolverId::k5pt;

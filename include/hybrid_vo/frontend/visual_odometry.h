@@ -55,9 +55,6 @@ struct VisualOdometryOptions {
   bool stereo_current_disparity = true;  // fit the current frame's disparities too
   bool use_vp_tracker = true;
   VpTrackerOptions vp_tracker;
-  // Weight of a VP residual in the final refinement when the tracker feeds the VPs (1: one radian
-  // counts as f pixels); tracked directions are averaged, hence more than one point's worth.
-  double tracked_vp_weight = 3.0;
 };
 
 // Externally detected features of a frame (e.g. from a learned front end); ids link them across
@@ -113,7 +110,9 @@ struct VisualOdometryResult {
   Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
-  std::vector<int> vp_track_ids; // per VP match of the pair: its track, or -1
+  std::vector<int> vp_track_ids; // per VP match of the pair: the track of its prior, or -1
+  // Per VP the pose accepted, as seen in the current image: its track and the tracker's gate.
+  std::vector<VpAssociation> vp_associations;
   int num_point_matches = 0, num_line_matches = 0;
   LineTrackingStats line_tracking;  // with track_lines
   // Wall clock: image to matches, VPs + estimator, the whole frame; and per stage.

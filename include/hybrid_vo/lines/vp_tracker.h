@@ -9,84 +9,117 @@
 namespace hybrid_vo {
 
 struct VpTrackerOptions {
-  // A detection joins the closest track within this angle (sign-agnostic, in the odometry frame).
+  // A detection joins the closest track within this angle (sign-agnostic, in the odometry frame)
+  // that also passes the chi-square gate below.
   double association_angle_deg = 3.0;
   // A track that went this many frames in a row without a detection survives; one more drops it.
   int max_misses = 5;
-  // Detections (in total) before a track is confident: clutter rarely recurs in the same direction.
+  // Detections fused (in total) before a track is confident and feeds priors: clutter rarely
+  // recurs in the same direction.
   int confirm_hits = 3;
   // No new tracks beyond this many; <= 0 means no cap.
   int max_tracks = 16;
-  // Fraction of a track's accumulated weight kept per frame. The direction is a weighted mean over
-  // roughly 1 / (1 - memory) frames: long enough to average the detector's noise, short enough to
-  // follow the slow drift of the odometry frame. 1 keeps every detection at full weight.
-  double memory = 0.9;
+  // Random walk of a track's direction per frame (degrees, per axis): how fast the track may
+  // follow the odometry frame's rotational drift. Small: the track anchors the rotation.
+  double process_noise_deg = 0.02;
+  // Chi-square gate (2 dof) of a detection against its track, under the track's covariance plus
+  // the detection's: 9.21 keeps 99 % of consistent detections.
+  double gate_chi2 = 9.21;
+  // A track whose associated detections fail the gate this many frames in a row is dropped: its
+  // direction no longer agrees with the rotation the points support.
+  int max_gate_failures = 2;
+  // Sigma given to a detection without a usable covariance, and the floor of every detection's
+  // sigma (degrees): no detection is trusted beyond what rounding and lens models allow.
+  double default_sigma_deg = 1.0;
+  double min_sigma_deg = 0.005;
+};
+
+// One VP seen in the current camera.
+struct VpObservation {
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // camera frame, any scale or sign
+  // Covariance of the unit direction in the camera frame (rad^2, tangent plane), e.g. from its
+  // segments (vp_direction_covariance). Zero: default_sigma_deg.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
 struct VpTrack {
   int id = -1;  // stable, never reused (not even after reset)
   // Unit, in the odometry frame, with the sign of the track's first detection.
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
-  int hits = 0;     // detections associated so far
-  int misses = 0;   // consecutive frames without a detection
+  // Of the direction (rad^2, 3x3 of rank 2, in the tangent plane of `direction`).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  int hits = 0;     // detections fused so far
+  int misses = 0;   // consecutive frames without a fused detection
   int age = 0;      // frames since creation (0 in the frame that created it)
   bool confident = false;  // hits >= confirm_hits
-  double weight = 0.0;     // accumulated, decayed weight of the detections behind `direction`
-  double last_angle_deg = 0.0;  // angle of the last detection to the track before it was merged
+  int last_update = -1;    // the frame (count of update calls) of the last fused detection
+  // The gate: the last associated detection's chi-square, whether it passed, failures in a row
+  // and in total.
+  double last_chi2 = 0.0;
+  bool last_gate_passed = true;
+  int gate_failures = 0, total_gate_failures = 0;
+  // Standard deviation of the direction, degrees: sqrt of the covariance's largest eigenvalue.
+  double sigma_deg() const;
 };
 
-// Carries VP directions across frames in the odometry frame (DESIGN.md, "Vanishing points").
-// A VP is a scene direction, so once rotated into the odometry frame it stays put up to the
-// odometry's rotational drift; tracks average detections there, associated by angle.
+// Per observation of an update: its track (or -1), and the gate's verdict.
+struct VpAssociation {
+  int track_id = -1;
+  double chi2 = 0.0;       // against the track; 0 when it started a track or was ignored
+  bool gated_out = false;  // associated by angle but failed the chi-square gate
+};
+
+// Carries VP directions across frames in the odometry frame (DESIGN.md, "Vanishing points") as a
+// Kalman filter on the sphere: a VP is a scene direction, so once rotated into the odometry frame
+// it stays put up to the odometry's rotational drift (the process noise). Each track has a
+// covariance, fused from its detections' covariances; detections that disagree with it beyond
+// the gate are not fused, and a track that keeps failing is dropped. The estimator receives the
+// tracks as priors (`priors`), weighted by their covariance, never as fixed directions.
 //
-// Intended use per frame k+1 of the node, with R_wc[k] the rotation of camera k into odometry:
-//   ids = tracker.refine_matches(R_wc[k], &pair.vps);   // smoother d1 for the estimator
+// Intended use per frame k+1 of the odometry, with R_wc[k] the rotation of camera k into odometry:
+//   pair.vp_priors = tracker.priors(R_wc[k], pair.vps);   // the estimator gates and uses them
 //   ... estimate R (X2 = R X1 + t), R_wc[k+1] = R_wc[k] * R^T ...
-//   tracker.update(R_wc[k+1], d2 of the pair's VP matches, their segment counts);
-// and once, for the first pair, tracker.update(R_wc[0], d1 of its VP matches) beforehand.
+//   tracker.update(R_wc[k+1], the pair's inlier VPs seen in image 2, with covariances);
+// and once, for the first pair, tracker.update(R_wc[0], its VPs in image 1) beforehand.
 class VpTracker {
  public:
   explicit VpTracker(const VpTrackerOptions& options = {});
 
-  // One frame. `directions` are VPs observed in the current camera (any scale, either sign) and
-  // R_world_from_camera takes that camera's frame into the odometry frame. `weights` (e.g. the
-  // number of supporting segments) default to 1. Returns per observation the id of its track, or
-  // -1 when it was ignored:
-  //  - non-finite or zero direction, or non-finite or non-positive weight;
-  //  - a duplicate: within the association angle of a track that another observation of the
-  //    same frame joined (being closer) or started (being heavier); a second track there would
-  //    split the VP's later detections and swap ids;
-  //  - unmatched while max_tracks tracks exist.
-  // Other unmatched observations start new tracks, heaviest first. An invalid rotation (non-finite,
-  // not orthonormal within 1e-6, or a reflection) or a weights size other than 0 or
-  // directions.size() leaves the tracker untouched and returns all -1.
-  std::vector<int> update(const Eigen::Matrix3d& R_world_from_camera,
-                          const std::vector<Eigen::Vector3d>& directions,
-                          const std::vector<double>& weights = {});
+  // One frame: predicts every track (process noise), then associates each valid observation with
+  // the closest track within the association angle, one observation per track, closest first.
+  // An associated observation inside the chi-square gate is fused; outside, the track counts a
+  // gate failure and is dropped after max_gate_failures in a row. Unassociated observations start
+  // tracks, most certain first, unless they duplicate a track or max_tracks tracks exist.
+  // Ignored (track_id -1): non-finite or zero directions, non-finite covariances. An invalid
+  // rotation (non-finite, not orthonormal within 1e-6, or a reflection) leaves the tracker
+  // untouched and ignores every observation.
+  std::vector<VpAssociation> update(const Eigen::Matrix3d& R_world_from_camera,
+                                    const std::vector<VpObservation>& observations);
 
   // Current tracks in order of creation (increasing id).
   const std::vector<VpTrack>& tracks() const { return tracks_; }
   // The track with this id, or nullptr once it is dropped.
   const VpTrack* find(int id) const;
 
-  // Feeds confident tracks to the estimator: for each VP match of the next pair whose d1 (in
-  // camera 1, rotated into odometry by R_world_from_camera1) lies within the association angle of
-  // a confident track, d1 becomes that track's unit direction in camera 1, signed like the old d1
-  // so that sign_known stays true; d2 is kept. One match per track, closest first. Returns per
-  // match the id of the track that replaced its d1, or -1 (match unchanged). An invalid rotation
-  // changes nothing.
-  std::vector<int> refine_matches(const Eigen::Matrix3d& R_world_from_camera1,
-                                  std::vector<VpMatch>* matches) const;
+  // Priors for the next pair's VP matches: for each match whose d1 (camera 1, rotated into
+  // odometry by R_world_from_camera1) lies within the association angle of a confident track, the
+  // track's direction and covariance in camera 1 (plus one step of process noise), signed like
+  // d1. One match per track, closest first; the others get an invalid prior. An invalid rotation
+  // gives only invalid priors.
+  std::vector<VpPrior> priors(const Eigen::Matrix3d& R_world_from_camera1,
+                              const std::vector<VpMatch>& matches) const;
 
   // Drops every track, e.g. when time goes backwards; ids keep increasing.
   void reset() { tracks_.clear(); }
 
   const VpTrackerOptions& options() const { return options_; }
+  int frames() const { return frame_; }
 
  private:
   VpTrackerOptions options_;
   std::vector<VpTrack> tracks_;
   int next_id_ = 0;
+  int frame_ = 0;  // update calls so far
 };
 
 }  // namespace hybrid_vo

@@ -132,6 +132,7 @@ class VoNode {
   // Under stats_mutex_.
   void add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) const;
   void add_counters(diagnostic_updater::DiagnosticStatusWrapper& status) const;
+  void add_vp_tracks(diagnostic_updater::DiagnosticStatusWrapper& status) const;
 
   ros::NodeHandle nh_, pnh_;
   image_transport::ImageTransport it_;
@@ -210,6 +211,10 @@ class VoNode {
   // Stereo frames whose scale fell back to mono_scale, and the last reason.
   int stereo_scale_fallbacks_ = 0;
   std::string last_scale_fallback_;
+  // The VP tracker after the last frame, and its gates: priors the estimator used or rejected,
+  // and detections that failed their track's gate (VpTracker).
+  std::vector<VpTrack> vp_tracks_;
+  int vp_priors_used_ = 0, vp_priors_rejected_ = 0, vp_track_gate_failures_ = 0;
 };
 
 }  // namespace hybrid_vo
