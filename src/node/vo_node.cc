@@ -125,8 +125,8 @@ void VoNode::load_odometry_options() {
   o.klt.predict_motion = pnh_.param("klt_predict_motion", true);
   o.klt.window_px = pnh_.param("klt_window_px", o.klt.window_px);
   if (o.klt.window_px < 5) {
-    ROS_WARN("hybrid_vo: klt_window_px must be >= 5, using 21");
-    o.klt.window_px = 21;
+    ROS_WARN("hybrid_vo: klt_window_px must be >= 5, using %d", KltTrackerOptions().window_px);
+    o.klt.window_px = KltTrackerOptions().window_px;
   }
   o.concurrent = pnh_.param("concurrent_frontend", true);
 }

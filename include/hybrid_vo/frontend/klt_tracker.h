@@ -14,7 +14,10 @@ struct KltTrackerOptions {
   int grid_cols = 8, grid_rows = 6;  // bucketing: re-detection fills empty cells first
   double min_distance_px = 10.0;     // between tracked features
   double quality_level = 0.01;       // of cv::goodFeaturesToTrack
-  int window_px = 21;
+  // Lucas-Kanade's cost grows with the window's area: 11 px costs about a quarter of 21 px, and
+  // through the odometry it is as accurate or better on KITTI 01 (AUC@10 95.96 against 95.83)
+  // and the rendered corridor (ATE 0.0104 against 0.0176 m) (README, "The VO node").
+  int window_px = 11;
   int pyramid_levels = 3;
   double max_forward_backward_px = 1.0;  // forward-backward check of each track
   int max_iterations = 30;              // Lucas-Kanade iterations per pyramid level
