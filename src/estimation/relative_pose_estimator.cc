@@ -216,14 +216,6 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
   refinement.point_loss_px = options.ransac.point_threshold_px;
   refinement.line_vp_loss_px = options.scales.line_threshold_px;
   refinement.vp_loss_deg = options.ransac.vp_threshold_deg;
-  // However many point matches there are, their errors are not independent (KLT's errors
-  // correlate between neighbouring tracks; calibration and rolling shutter shift all of them),
-  // so together they carry at most the information of max_independent_points matches.
-  const double dependence = std::sqrt(
-      std::max(1.0, static_cast<double>(data.points.size()) /
-                        std::max(1.0, options.scales.max_independent_points)));
-  for (double& sigma : data.point_sigma_px) sigma *= dependence;
-  est->scales.point_dependence = dependence;
   auto accept = [&](const FinalRefinementResult& r) {
     std::vector<char> after;
     if (!r.success || scorer.pool_inliers(r.pose, &after) < 0.95 * pool_before) return false;
@@ -236,11 +228,22 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
   accept(refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose, refinement));
 
   if (matches.vp_priors.size() != matches.vps.size() || data.vps.empty()) return;
+  // Against a prior, which carries many frames, the pair's point matches are not independent
+  // (KLT's errors correlate between neighbouring tracks and from frame to frame; calibration
+  // and rolling shutter shift all of them): together they count as at most
+  // max_independent_points matches, in the gate (their rotation's covariance) and in the
+  // refinement with the priors. A pair alone (no prior) keeps the measured sigmas.
+  const double dependence = std::sqrt(
+      std::max(1.0, static_cast<double>(data.points.size()) /
+                        std::max(1.0, options.scales.max_independent_points)));
+  for (double& sigma : data.point_sigma_px) sigma *= dependence;
+  est->scales.point_dependence = dependence;
   data.vp_priors.assign(data.vps.size(), VpPrior());
   bool any = false;
-  const Eigen::Matrix3d rotation_covariance = est->covariance_valid
-                                                  ? Eigen::Matrix3d(est->covariance.topLeftCorner<3, 3>())
-                                                  : Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d rotation_covariance =
+      est->covariance_valid
+          ? Eigen::Matrix3d(dependence * dependence * est->covariance.topLeftCorner<3, 3>())
+          : Eigen::Matrix3d::Zero();
   for (size_t j = 0; j < data.vps.size(); ++j) {
     const int k = internal_index[j];
     const int input = problem.vp_index[k];
