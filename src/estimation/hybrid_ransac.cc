@@ -27,9 +27,9 @@ class LocalOptimizer {
     const double focal = 0.5 * (problem.camera1.mean_focal() + problem.camera2.mean_focal());
     refinement_.max_iterations = 10;
     refinement_.loss_scale = options.point_threshold_px / focal;
-    // A VP at its threshold weighs like a point at its threshold, times sqrt of its score weight.
+    // A VP at its threshold weighs like a point at its threshold, once per row (ModelScorer).
     refinement_.vp_weight = refinement_.loss_scale / (options.vp_threshold_deg * kDegree) *
-                            std::sqrt(options.vp_score_weight);
+                            std::sqrt(ModelScorer::kVpRows);
   }
 
   // Refines `pose` on (a subset of) its inliers under `widen` times the threshold; true with `cost`
@@ -87,8 +87,7 @@ HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,
                                       const HybridRansacOptions& options, std::mt19937_64* rng) {
   HybridRansacOutcome out;
   MinimalSampler sampler(problem, rng);
-  const ModelScorer scorer(problem, options.point_threshold_px, options.vp_threshold_deg * kDegree,
-                           options.vp_score_weight);
+  const ModelScorer scorer(problem, options.point_threshold_px, options.vp_threshold_deg * kDegree);
   LocalOptimizer optimizer(problem, scorer, options, rng);
 
   std::vector<int> active;

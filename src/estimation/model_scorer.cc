@@ -8,11 +8,10 @@
 namespace hybrid_vo {
 
 ModelScorer::ModelScorer(const HybridProblem& problem, double point_threshold_px,
-                         double vp_threshold_rad, double vp_weight)
+                         double vp_threshold_rad)
     : problem_(problem),
       point_threshold_sq_(point_threshold_px * point_threshold_px),
       vp_threshold_sq_(vp_threshold_rad * vp_threshold_rad),
-      vp_weight_(vp_weight),
       K1_inverse_(problem.camera1.K_inverse()),
       K2_inverse_transpose_(problem.camera2.K_inverse().transpose()) {}
 
@@ -48,7 +47,7 @@ double ModelScorer::cost(const RelativePose& pose, double bound) const {
   double total = 0.0;
   for (int k = 0; k < problem_.num_vps(); ++k) {
     const double a = vp_angle(pose.R, k);
-    total += vp_weight_ * std::min(a * a / vp_threshold_sq_, 1.0);
+    total += kVpRows * std::min(a * a / vp_threshold_sq_, 1.0);
   }
   const Eigen::Matrix3d F = fundamental(pose);
   const int n = problem_.num_pool();

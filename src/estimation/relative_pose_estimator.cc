@@ -371,8 +371,7 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
 
   est.pose = outcome.best;
   const ModelScorer scorer(problem, options.ransac.point_threshold_px,
-                           options.ransac.vp_threshold_deg * kDegree,
-                           options.ransac.vp_score_weight);
+                           options.ransac.vp_threshold_deg * kDegree);
   std::vector<char> pool;
   if (scorer.pool_inliers(est.pose, &pool) < options.min_point_inliers)
     return finish(EstimationStatus::kNoModel);

@@ -163,7 +163,6 @@ const OptionTable<TwoViewOptions>& estimator_option_table() {
         .add("prior", FIELD(estimator.ransac.prior), Range::kNonNegative)
         .add("point_threshold_px", FIELD(estimator.ransac.point_threshold_px), Range::kPositive)
         .add("vp_threshold_deg", FIELD(estimator.ransac.vp_threshold_deg), Range::kPositive)
-        .add("vp_score_weight", FIELD(estimator.ransac.vp_score_weight), Range::kNonNegative)
         .add("line_inlier_ratio", FIELD(estimator.ransac.line_inlier_ratio), Range::kFraction)
         .add("initial_point_inlier_ratio", FIELD(estimator.ransac.initial_point_inlier_ratio),
              Range::kFraction)

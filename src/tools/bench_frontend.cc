@@ -57,6 +57,7 @@ int run(int argc, char** argv) {
   double period_ms = 0.0;
   int max_features = 1500;
   bool verbose = false;
+  int vp_min_inliers = 6;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -72,6 +73,7 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--verbose") verbose = true;
+    else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
     else if (a == "--period-ms" && i + 1 < argc) period_ms = std::atof(argv[++i]);
     else if (a == "--stereo-window" && i + 1 < argc) o.stereo.window_px = std::atoi(argv[++i]);
     else if (a == "--stereo-levels" && i + 1 < argc) o.stereo.pyramid_levels = std::atoi(argv[++i]);
@@ -90,7 +92,7 @@ int run(int argc, char** argv) {
   }
   // As config/kitti.yaml sets the node.
   o.klt.max_features = o.features.points.max_features = max_features;
-  o.estimator.vp_detection.min_inliers = 6;
+  o.estimator.vp_detection.min_inliers = vp_min_inliers;
 
   std::string error;
   datasets::KittiCalibration calibration;

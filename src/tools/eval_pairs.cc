@@ -41,6 +41,8 @@ struct Arguments {
   int runs = 1;                   // RANSAC repetitions per pair and method, pooled into one AUC
   int min_iterations = -1;        // overrides of the presets' RANSAC settings (-1: preset's own)
   double point_threshold = -1.0;  // also used for OpenCV (default 1 px)
+  double five_point_share = -1.0;  // -1: the preset's own
+  int vp_min_inliers = -1;         // -1: TwoViewOptions' own
   // The few-points regime: every value of max_points (-1: all) with every selection.
   std::vector<int> max_points;
   std::vector<datasets::PointSelection> selections = {datasets::PointSelection::kRandom};
@@ -63,6 +65,7 @@ void usage(const char* program) {
       << "         [--images DIR] [--gap K] [--resize S] [--presets a,b,...] [--csv FILE]\n"
       << "         [--vp-modes] [--max-pairs N] [--points sift|orb] [--lines lsd|fld] [--seed S]\n"
       << "         [--runs N] [--min-iterations N] [--point-threshold PX]\n"
+      << "         [--five-point-share S] [--vp-min-inliers N] (knobs of the hybrid RANSAC)\n"
       << "         [--max-points N[,N...|all]] [--point-selection random|clustered[,...]]\n"
       << "  Pairs are frames i and i+K (superglue: the pairs file, images under --images).\n"
       << "  Prints method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms (AUC in %),\n"
@@ -134,6 +137,14 @@ bool parse(int argc, char** argv, Arguments* a) {
       a->point_threshold = std::strtod(v.c_str(), &end);
       if (*end || !(a->point_threshold > 0.0))
         return std::cerr << "error: --point-threshold must be > 0\n", false;
+    } else if (arg == "--vp-min-inliers") {
+      a->vp_min_inliers = static_cast<int>(std::strtol(v.c_str(), &end, 10));
+      if (*end || a->vp_min_inliers < 2)
+        return std::cerr << "error: --vp-min-inliers must be >= 2\n", false;
+    } else if (arg == "--five-point-share") {
+      a->five_point_share = std::strtod(v.c_str(), &end);
+      if (*end || !(a->five_point_share >= 0.0 && a->five_point_share <= 1.0))
+        return std::cerr << "error: --five-point-share must be in [0, 1]\n", false;
     } else if (arg == "--max-points") {
       a->max_points.clear();
       for (const std::string& item : evaluation::split_list(v)) {
@@ -365,6 +376,9 @@ int main(int argc, char** argv) {
           if (args.min_iterations > 0) options.estimator.ransac.min_iterations = args.min_iterations;
           if (args.point_threshold > 0.0)
             options.estimator.ransac.point_threshold_px = args.point_threshold;
+          if (args.vp_min_inliers > 0) options.vp_detection.min_inliers = args.vp_min_inliers;
+          if (args.five_point_share >= 0.0)
+            options.estimator.ransac.five_point_share = args.five_point_share;
           options.estimator.ransac.seed = seed;
           const auto start = std::chrono::steady_clock::now();
           const TwoViewEstimate result =

@@ -25,11 +25,6 @@ struct HybridRansacOptions {
   // Inlier thresholds: Sampson error of point-like matches in pixels, angle of VP matches.
   double point_threshold_px = 1.0;
   double vp_threshold_deg = 2.0;
-  // One VP match scores like this many point matches. A VP fixes two rotation parameters to
-  // about a degree, a point one epipolar constraint to a pixel; the likelihood ratio of an inlier
-  // against a uniform outlier is a few times a point's. At 10 a spurious VP outweighed a dozen
-  // point inliers and chose wrong translations (KITTI pair 22, TUM; README, pair evaluation).
-  double vp_score_weight = 3.0;
   // A line match alone cannot be verified by a relative pose, so solver selection uses a preset
   // line inlier ratio (paper Sec. 4). Termination uses the measured support instead (lines with
   // an inlier junction or agreeing with an inlier VP), a lower bound. Points and VPs start from
