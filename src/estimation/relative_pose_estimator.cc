@@ -216,16 +216,20 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
   refinement.point_loss_px = options.ransac.point_threshold_px;
   refinement.line_vp_loss_px = options.scales.line_threshold_px;
   refinement.vp_loss_deg = options.ransac.vp_threshold_deg;
-  auto accept = [&](const FinalRefinementResult& r) {
+  // A refinement is kept unless it loses inliers: 5 % without priors; with priors that passed
+  // their gate, half (a gated prior may correct a RANSAC model that fits the points wrongly,
+  // e.g. a rotation-translation confusion, and then moves it by more than the threshold).
+  auto accept = [&](const FinalRefinementResult& r, double keep) {
     std::vector<char> after;
-    if (!r.success || scorer.pool_inliers(r.pose, &after) < 0.95 * pool_before) return false;
+    if (!r.success || scorer.pool_inliers(r.pose, &after) < keep * pool_before) return false;
     est->pose = r.pose;
     est->covariance = r.covariance;
     est->covariance_valid = r.covariance_valid;
     est->refined = true;
     return true;
   };
-  accept(refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose, refinement));
+  accept(refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose, refinement),
+         0.95);
 
   if (matches.vp_priors.size() != matches.vps.size() || data.vps.empty()) return;
   // Against a prior, which carries many frames, the pair's point matches are not independent
@@ -257,7 +261,8 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
     any = true;
   }
   if (any && !accept(refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose,
-                                                refinement)))
+                                                refinement),
+                     0.5))
     std::fill(est->vp_prior_used.begin(), est->vp_prior_used.end(), 0);
 }
 

@@ -73,6 +73,8 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--verbose") verbose = true;
+    else if (a == "--seed" && i + 1 < argc)
+      o.estimator.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
     else if (a == "--period-ms" && i + 1 < argc) period_ms = std::atof(argv[++i]);
     else if (a == "--stereo-window" && i + 1 < argc) o.stereo.window_px = std::atoi(argv[++i]);
