@@ -45,6 +45,7 @@ void usage(const char* program) {
             << " --bag STEREO.bag [--preset P] [--max-features N] [--frames N]\n"
                "       [--scene corridor|room [--seed N]] [--dump POINTS.csv]\n"
                "       [--klt-window PX] [--klt-predict 0|1] [--klt-predicted-levels N]\n"
+               "       [--refine-tracks 0|1] [--refine-window PX]\n"
                "  Runs VisualOdometry over the bag's /camera/{left,right}/{image_raw,camera_info}\n"
                "  and compares stereo scale estimators against /ground_truth/pose: per pair the\n"
                "  ratio of estimated to true translation length, then per estimator the median\n"
@@ -249,6 +250,8 @@ int main(int argc, char** argv) {
   int max_features = 1000, max_frames = 1 << 30;
   uint64_t seed = 1;
   hybrid_vo::KltTrackerOptions klt;
+  bool refine_tracks = hybrid_vo::VisualOdometryOptions().stereo_refine_tracks;
+  int refine_window = hybrid_vo::AffineTrackingOptions().window_px;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&] { return evaluation::option_value(argc, argv, &i); };
@@ -262,6 +265,8 @@ int main(int argc, char** argv) {
     else if (a == "--klt-window") klt.window_px = std::stoi(next());
     else if (a == "--klt-predict") klt.predict_motion = std::stoi(next()) != 0;
     else if (a == "--klt-predicted-levels") klt.predicted_pyramid_levels = std::stoi(next());
+    else if (a == "--refine-tracks") refine_tracks = std::stoi(next()) != 0;
+    else if (a == "--refine-window") refine_window = std::stoi(next());
     else if (a == "--help" || a == "-h") {
       usage(argv[0]);
       return 0;
@@ -299,6 +304,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   options.klt = klt;
+  options.stereo_refine_tracks = refine_tracks;
+  options.stereo_track_refinement.window_px = refine_window;
   options.klt.max_features = max_features;
   options.estimator.vp_detection.min_inliers = 6;  // as the node
   hybrid_vo::VisualOdometry vo(options);
@@ -306,7 +313,7 @@ int main(int argc, char** argv) {
   // Run once; keep each pair's data and the rotations (the same for every candidate).
   std::vector<Pair> pairs;
   std::map<double, Eigen::Matrix3d> rotation_at;  // camera-to-odometry rotation by stamp
-  std::vector<double> total_ms;
+  std::vector<double> total_ms, scale_ms;
   int n = 0;
   for (const auto& [stamp_ns, f] : frames) {
     if (n++ >= max_frames) break;
@@ -321,6 +328,7 @@ int main(int argc, char** argv) {
     }
     const hybrid_vo::VisualOdometryResult r = vo.process(input);
     total_ms.push_back(r.total_ms);
+    if (r.status == hybrid_vo::VoStatus::kOk) scale_ms.push_back(r.stages.scale_ms);
     if (r.status == hybrid_vo::VoStatus::kFirstFrame) rotation_at[input.stamp] = r.R_wc;
     if (r.status != hybrid_vo::VoStatus::kOk) continue;
     rotation_at[input.stamp] = r.R_wc;
@@ -462,8 +470,10 @@ int main(int argc, char** argv) {
     }
     std::printf("\n");
   }
-  std::printf("# %zu frames, %zu pairs estimated; VisualOdometry median %.1f ms per frame\n",
-              frames.size(), pairs.size(), evaluation::median(total_ms));
+  std::printf("# %zu frames, %zu pairs estimated; VisualOdometry median %.1f ms per frame, "
+              "scale (refinement and fit) %.2f ms\n",
+              frames.size(), pairs.size(), evaluation::median(total_ms),
+              evaluation::median(scale_ms));
   for (size_t k = 0; k < candidates.size(); ++k) {
     Trajectory t;
     for (const auto& [stamp, c] : centres[k]) {
