@@ -366,13 +366,17 @@ int main(int argc, char** argv) {
   // The node's default: the depth-limited fit with the self-calibrated disparity offset
   // (DisparityOffsetFilter, updated pair by pair as VisualOdometry does).
   std::vector<std::shared_ptr<hybrid_vo::DisparityOffsetFilter>> filters;  // the default's first
+  // filter_point_sigma_px > 0: the offset filter's fit weighs the current points so too.
   auto calibrated = [&filters](double max_baselines, double offset_sigma = 0.0,
-                       double point_sigma_px = hybrid_vo::StereoScaleOptions().point_sigma_px) {
+                               double point_sigma_px = hybrid_vo::StereoScaleOptions().point_sigma_px,
+                               double filter_point_sigma_px = 0.0) {
     auto filter = std::make_shared<hybrid_vo::DisparityOffsetFilter>();
     filters.push_back(filter);
     return [=](const Pair& p, double* sigma) {
       hybrid_vo::StereoScaleOptions o;
+      if (filter_point_sigma_px > 0.0) o.point_sigma_px = filter_point_sigma_px;
       filter->update(p.unit, p.rig, p.observations, o);
+      o = hybrid_vo::StereoScaleOptions();
       o.max_depth_baselines = max_baselines;
       o.disparity_offset_px = filter->offset();
       o.disparity_offset_sigma_px = offset_sigma;
@@ -393,7 +397,13 @@ int main(int argc, char** argv) {
       {"cal+p0.1", calibrated(0.0, 0.1)},
       {"cal+p0.2", calibrated(0.0, 0.2)},
       {"cal<40b+p0.1", calibrated(40.0, 0.1)},
-      {"default,pt0.25", calibrated(40.0, 0.0, 0.25)},  // image points weighted twice as much
+      // The current points' noise (pixels) in the fit, and in the offset filter's fit (f): the
+      // tracker's points' weight (0.5), the refined points' measured one (0.3, as the
+      // disparities'), and mixtures.
+      {"pt0.5", calibrated(40.0, 0.0, 0.5, 0.5)},
+      {"pt0.3", calibrated(40.0, 0.0, 0.3, 0.3)},
+      {"pt0.3,f0.5", calibrated(40.0, 0.0, 0.3, 0.5)},
+      {"pt0.25,f0.5", calibrated(40.0, 0.0, 0.25, 0.5)},
       {"median", [](const Pair& p, double*) { return hybrid_vo::median_of_point_scales(p.unit, p.rig, p.observations, 0.0); }},
       {"median<40b", [](const Pair& p, double*) { return hybrid_vo::median_of_point_scales(p.unit, p.rig, p.observations, 40.0); }},
       {"ml", ml(0.0)},
