@@ -24,10 +24,12 @@ inline float bilinear(const cv::Mat& image, float x, float y) {
   return top + fy * (bottom - top);
 }
 
-// True when every point within (rx, ry) of p can be sampled.
+// True when every point within (rx, ry) of p can be sampled, with a hundredth of a pixel to
+// spare for the rounding of the samples' float coordinates.
 bool inside(const cv::Mat& image, const Eigen::Vector2d& p, double rx, double ry) {
-  return p.x() - rx >= 0.0 && p.y() - ry >= 0.0 && p.x() + rx < image.cols - 1.0 &&
-         p.y() + ry < image.rows - 1.0;
+  constexpr double kSpare = 0.01;
+  return p.x() - rx >= kSpare && p.y() - ry >= kSpare && p.x() + rx < image.cols - 1.0 - kSpare &&
+         p.y() + ry < image.rows - 1.0 - kSpare;
 }
 
 // A square window of side 2 half + 1 around a point, its pixels row by row.
