@@ -1,5 +1,6 @@
-// Stereo scale (estimation/stereo_scale) on synthetic highway-like scenes, and stereo matching
-// (frontend/stereo) on a rendered pair with known depth.
+// Stereo scale (estimation/stereo_scale) on synthetic highway-like scenes, stereo matching
+// (frontend/stereo) on a rendered pair with known depth, and the affine refinement of the
+// scale's current points (frontend/affine_tracking) on a synthetic approaching plane.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,8 +10,10 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include "hybrid_vo/estimation/stereo_scale.h"
+#include "hybrid_vo/frontend/affine_tracking.h"
 #include "hybrid_vo/frontend/stereo.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/rotation.h"
@@ -273,6 +276,115 @@ TEST(StereoPoints, RenderedPairHasUnbiasedDisparities) {
   const std::vector<Eigen::Vector3d> none = stereo_points(
       left.image, right.image(cv::Rect(0, 0, 100, 100)), pixels, camera, 0.1, &valid);
   EXPECT_TRUE(std::all_of(valid.begin(), valid.end(), [](char v) { return !v; }));
+}
+
+// A textured floor that the camera approaches (as the corridor's, drawn here without the
+// renderer: each image samples the floor's texture through the plane's projection). Between the
+// frames each window grows by 4-6 %, more at its bottom than at its top. A translated window's
+// error along the flow is then systematic: its sign depends on where the texture's gradients lie
+// in the window (here it runs ahead of the point; on the rendered corridor it lags, which made
+// the stereo scale short: test_visual_odometry). The affine window follows the growth.
+TEST(AffineTracking, FollowsAWindowThatGrows) {
+  // Floor texture: smooth random grey (a grain of about 3 cm) over 8 x 20 m ahead of the camera,
+  // 120 texels per metre.
+  constexpr double kTexels = 120.0, kHalfWidth = 4.0, kLength = 20.0;
+  cv::Mat coarse(static_cast<int>(kLength * kTexels / 4),
+                 static_cast<int>(2 * kHalfWidth * kTexels / 4), CV_32F);
+  cv::RNG rng(5);
+  rng.fill(coarse, cv::RNG::UNIFORM, 0.0, 255.0);
+  cv::Mat texture;
+  cv::resize(coarse, texture, cv::Size(), 4.0, 4.0, cv::INTER_CUBIC);
+  // A camera 1.45 m above the floor looking level (f 460 px, 640 x 480): the floor point
+  // (X, Z) is seen at (f X / Z + cx, f h / Z + cy); the second frame is dz = 0.15 m ahead.
+  constexpr double f = 460.0, cx = 319.5, cy = 239.5, h = 1.45, dz = 0.15;
+  // Each pixel averages 3 x 3 samples (the renderer's antialiasing), so that the fine texture
+  // near the horizon does not alias.
+  auto render = [&](double z0) {
+    constexpr int ss = 3;
+    cv::Mat map_x(480 * ss, 640 * ss, CV_32F, cv::Scalar(-1.0f)), map_y = map_x.clone();
+    for (int y = 0; y < 480 * ss; ++y)
+      for (int x = 0; x < 640 * ss; ++x) {
+        const double u = (x + 0.5) / ss - 0.5, v = (y + 0.5) / ss - 0.5;
+        if (v < cy + 10.0) continue;
+        const double Z = f * h / (v - cy), X = (u - cx) * Z / f;
+        map_x.at<float>(y, x) = static_cast<float>((X + kHalfWidth) * kTexels);
+        map_y.at<float>(y, x) = static_cast<float>((Z + z0) * kTexels);
+      }
+    cv::Mat fine, image, grey;
+    cv::remap(texture, fine, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    cv::resize(fine, image, cv::Size(640, 480), 0, 0, cv::INTER_AREA);
+    // The renderer's optics and sensor: a slight blur, one grey level of noise.
+    cv::GaussianBlur(image, image, cv::Size(0, 0), 0.5);
+    cv::Mat noise(image.size(), CV_32F);
+    rng.fill(noise, cv::RNG::NORMAL, 0.0, 1.0);
+    image += noise;
+    image.convertTo(grey, CV_8U);
+    return grey;
+  };
+  const cv::Mat first = render(0.0), second = render(dz);
+  auto warp = [&](const Eigen::Vector2d& p) {
+    const double Z = f * h / (p.y() - cy) - dz, X = (p.x() - cx) * (Z + dz) / f;
+    return Eigen::Vector2d(f * X / Z + cx, f * h / Z + cy);
+  };
+  std::vector<cv::Point2f> corners, tracked;
+  cv::goodFeaturesToTrack(first(cv::Rect(30, 290, 580, 150)), corners, 400, 0.01, 8);
+  for (cv::Point2f& c : corners) c += cv::Point2f(30.0f, 290.0f);
+  std::vector<uchar> status;
+  std::vector<float> error;
+  cv::calcOpticalFlowPyrLK(first, second, corners, tracked, status, error, cv::Size(21, 21), 3);
+  std::vector<Eigen::Vector2d> from, to;
+  for (size_t i = 0; i < corners.size(); ++i) {
+    // Lucas-Kanade's lost points are not the point here (the node's fit discounts them).
+    const Eigen::Vector2d p(corners[i].x, corners[i].y);
+    if (!status[i] || (Eigen::Vector2d(tracked[i].x, tracked[i].y) - warp(p)).norm() > 1.0)
+      continue;
+    from.emplace_back(corners[i].x, corners[i].y);
+    to.emplace_back(tracked[i].x, tracked[i].y);
+  }
+  ASSERT_GT(from.size(), 100u);
+  std::vector<Eigen::Vector2d> refined = to;
+  const std::vector<char> ok = refine_tracks_affine(first, second, from, &refined);
+  // Error along each point's flow (negative: short of where it went) and its size.
+  std::vector<double> lk_along, along, size;
+  int n_ok = 0;
+  for (size_t i = 0; i < from.size(); ++i) {
+    if (!ok[i]) continue;
+    ++n_ok;
+    const Eigen::Vector2d truth = warp(from[i]), flow = (truth - from[i]).normalized();
+    lk_along.push_back((to[i] - truth).dot(flow));
+    along.push_back((refined[i] - truth).dot(flow));
+    size.push_back((refined[i] - truth).norm());
+  }
+  EXPECT_GT(n_ok, static_cast<int>(from.size()) * 9 / 10);
+  auto mean = [](const std::vector<double>& v) {
+    double sum = 0.0;
+    for (double x : v) sum += x;
+    return sum / v.size();
+  };
+  std::sort(size.begin(), size.end());
+  std::printf("along the flow: Lucas-Kanade %+.4f px, affine %+.4f px; affine error median "
+              "%.4f px, 90th percentile %.4f px\n",
+              mean(lk_along), mean(along), size[size.size() / 2], size[9 * size.size() / 10]);
+  EXPECT_GT(std::abs(mean(lk_along)), 0.015);  // the translated window's systematic error
+  EXPECT_LT(std::abs(mean(along)), 0.01);
+  EXPECT_LT(size[size.size() / 2], 0.03);
+  EXPECT_LT(size[9 * size.size() / 10], 0.08);
+
+  // A refinement that would move a point farther than max_shift_px, or a window off the image:
+  // not refined, and the point keeps its position.
+  AffineTrackingOptions strict;
+  strict.max_shift_px = 0.5;
+  std::vector<Eigen::Vector2d> off = {warp(from[0]) + Eigen::Vector2d(1.5, 0.0),
+                                      Eigen::Vector2d(2.0, 400.0)};
+  const std::vector<Eigen::Vector2d> off_from = {from[0], Eigen::Vector2d(2.0, 400.0)};
+  const std::vector<Eigen::Vector2d> off_start = off;
+  const std::vector<char> off_ok = refine_tracks_affine(first, second, off_from, &off, strict);
+  EXPECT_FALSE(off_ok[0]);
+  EXPECT_FALSE(off_ok[1]);
+  EXPECT_EQ(off, off_start);
+  std::vector<Eigen::Vector2d> near = {warp(from[0]) + Eigen::Vector2d(1.5, 0.0)};
+  EXPECT_TRUE(refine_tracks_affine(first, second, {from[0]}, &near)[0]);
+  EXPECT_LT((near[0] - warp(from[0])).norm(), 0.1);
 }
 
 }  // namespace

@@ -110,6 +110,7 @@ void VoNode::load_odometry_options() {
   o.stereo_scale.max_depth_baselines =
       pnh_.param("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines);
   o.stereo_offset.enabled = pnh_.param("stereo_offset_calibration", o.stereo_offset.enabled);
+  o.stereo_refine_tracks = pnh_.param("stereo_refine_tracks", o.stereo_refine_tracks);
   o.estimator.estimator.ransac.point_threshold_px = pnh_.param("point_threshold_px", 1.0);
   o.estimator.estimator.ransac.vp_threshold_deg = pnh_.param("vp_threshold_deg", 2.0);
   o.estimator.vp_detection.inlier_threshold_px = pnh_.param("vp_inlier_threshold_px", 2.0);

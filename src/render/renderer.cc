@@ -200,6 +200,25 @@ PinholeCamera default_camera(int width, int height) {
   return PinholeCamera(f, f, 0.5 * (width - 1), 0.5 * (height - 1), width, height);
 }
 
+int cast_ray(const Scene& scene, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+             double* t, double near) {
+  int hit = -1;
+  *t = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < scene.quads.size(); ++i) {
+    const Quad& q = scene.quads[i];
+    const int a = q.normal_axis();
+    // One-sided, as setup_quads: the origin must be on the side the normal points to.
+    if (q.normal[a] * (origin[a] - q.origin[a]) <= 1e-9) continue;
+    const double ti = (q.origin[a] - origin[a]) / direction[a];
+    if (!(ti > near) || ti >= *t) continue;
+    const Eigen::Vector2d uv = q.local(origin + ti * direction);
+    if (uv.x() < 0.0 || uv.x() > q.size_u || uv.y() < 0.0 || uv.y() > q.size_v) continue;
+    *t = ti;
+    hit = static_cast<int>(i);
+  }
+  return hit;
+}
+
 RenderedView render_view(const Scene& scene, const PinholeCamera& cam, const CameraPose& pose,
                          const RenderOptions& o) {
   check(cam.valid() && cam.width >= 1 && cam.height >= 1 && cam.width <= 8192 && cam.height <= 8192,

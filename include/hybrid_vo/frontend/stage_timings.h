@@ -15,6 +15,7 @@ struct StageTimings {
   double vps_ms = 0.0;            // joint VP detection and the VP tracker
   double ransac_ms = 0.0;         // hybrid RANSAC and the final refinement
   double stereo_ms = 0.0;         // stereo matching of the frame's points (second thread)
+  double scale_ms = 0.0;          // stereo scale: its points' affine refinement and the fit
 };
 
 // Milliseconds since `start`.

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "hybrid_vo/frontend/affine_tracking.h"
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/klt_tracker.h"
 #include "hybrid_vo/frontend/line_tracker.h"
@@ -53,6 +54,11 @@ struct VisualOdometryOptions {
   StereoScaleOptions stereo_scale;  // the metric scale from the keyframe's stereo points
   DisparityOffsetOptions stereo_offset;  // self-calibration of a constant disparity offset
   bool stereo_current_disparity = true;  // fit the current frame's disparities too
+  // The scale's current points re-tracked from the keyframe with an affine window (KLT tracking
+  // only): the tracker's translated window lags along the flow on surfaces that come closer,
+  // which shortens the scale (affine_tracking.h). The pose keeps the tracker's points.
+  bool stereo_refine_tracks = true;
+  AffineTrackingOptions stereo_track_refinement;
   bool use_vp_tracker = true;
   VpTrackerOptions vp_tracker;
 };
@@ -147,6 +153,7 @@ class VisualOdometry {
     std::map<int64_t, LineSegment> external_lines;      // id -> segment
     bool points_undistorted = false, lines_undistorted = false;
     CameraModel camera;
+    cv::Mat image;  // grey, kept for the scale's track refinement (stereo input only)
     Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   };
@@ -157,9 +164,24 @@ class VisualOdometry {
                                                const cv::Mat& gray,
                                                const std::vector<cv::Mat>* left_pyramid,
                                                const std::map<int64_t, Eigen::Vector2d>& points) const;
-  void make_keyframe(const VisualOdometryInput& input,
+  void make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
                      const std::map<int64_t, Eigen::Vector2d>& points,
                      std::map<int64_t, Eigen::Vector3d> points3d, ImageFeatures features);
+
+  // The scale's observations of an estimated pair: the keyframe's stereo points among the
+  // pose's point inliers, seen again (with their current disparities when known).
+  std::vector<StereoScaleObservation> scale_observations(
+      const VisualOdometryInput& input, const cv::Mat& gray, const TwoViewMatches& m,
+      const std::vector<int64_t>& point_ids, const std::vector<char>& inliers,
+      const std::map<int64_t, Eigen::Vector2d>& points,
+      const std::map<int64_t, Eigen::Vector3d>& current3d, bool tracking) const;
+  // Their current points (of KLT tracks `ids`, at `points` in this frame) re-tracked from the
+  // keyframe with an affine window (refine_tracks_affine); the near ones that cannot be are
+  // left out.
+  std::vector<StereoScaleObservation> refine_scale_points(
+      const VisualOdometryInput& input, const cv::Mat& gray,
+      const std::map<int64_t, Eigen::Vector2d>& points, const std::vector<int64_t>& ids,
+      std::vector<StereoScaleObservation> observations) const;
 
   // Every feature the KLT tracker holds, by id.
   std::map<int64_t, Eigen::Vector2d> klt_points() const;

@@ -41,6 +41,13 @@ struct RenderedView {
 RenderedView render_view(const Scene& scene, const PinholeCamera& camera, const CameraPose& pose,
                          const RenderOptions& options = {});
 
+// The nearest quad that the ray origin + t direction hits from its front side (as drawn), at
+// t > near: its index, or -1, with t. For a direction of camera z 1, t is the camera depth, the
+// exact one that evaluations compare measured depths with (rendered depth maps are at pixel
+// centres only).
+int cast_ray(const Scene& scene, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+             double* t, double near = 0.05);
+
 // The renderer's default intrinsics for a width x height image: f = 0.72 * width (a 70-degree
 // horizontal field of view), principal point at the centre.
 PinholeCamera default_camera(int width = 640, int height = 480);
