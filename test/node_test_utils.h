@@ -15,6 +15,7 @@
 #include <hybrid_vo/FeatureLines.h>
 #include <hybrid_vo/FeaturePoints.h>
 #include <hybrid_vo/MotionEstimate.h>
+#include <hybrid_vo/VanishingPoints.h>
 #include <opencv2/core.hpp>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -69,6 +70,7 @@ class NodeHarness {
     lines_ = nh.advertise<FeatureLines>("features/lines", 5);
     motion_sub_ = nh.subscribe("hybrid_vo/relative_pose", 100, &NodeHarness::on_motion, this);
     diagnostics_sub_ = nh.subscribe("/diagnostics", 100, &NodeHarness::on_diagnostics, this);
+    vps_sub_ = nh.subscribe("hybrid_vo/vanishing_points", 100, &NodeHarness::on_vps, this);
   }
 
   bool wait_for_node(double seconds = 20.0) {
@@ -110,7 +112,10 @@ class NodeHarness {
   }
 
   ros::Publisher left_, left_info_, right_, right_info_, points_, lines_;
-  ros::Subscriber motion_sub_, diagnostics_sub_;
+  void on_vps(const VanishingPoints::ConstPtr& v) { last_vps_ = *v; }
+
+  ros::Subscriber motion_sub_, diagnostics_sub_, vps_sub_;
+  VanishingPoints last_vps_;  // the last ~vanishing_points
   std::map<ros::Time, MotionEstimate> motions_;  // the last answer per stamp
   std::vector<MotionEstimate> received_;          // every answer, in arrival order
   // When the first answer per stamp was handled (by spinOnce: spin often to time it well).

@@ -103,6 +103,30 @@ TEST(Replay, RenderedStereoSequence) {
   RecordProperty("path_m", std::to_string(path));
   EXPECT_EQ(h.last_odometry_status_.level, diagnostic_msgs::DiagnosticStatus::OK)
       << h.last_odometry_status_.message;
+
+  // The VP tracker: every track reports its uncertainty and gate; the corridor's Manhattan
+  // directions are tracked to a fraction of a degree, and the estimator used their priors.
+  int confident = 0;
+  for (const VanishingPoint& vp : h.last_vps_.vps) {
+    EXPECT_TRUE(std::isfinite(vp.sigma_deg) && vp.sigma_deg > 0.0) << "track " << vp.id;
+    EXPECT_TRUE(std::isfinite(vp.last_chi2) && vp.last_chi2 >= 0.0) << "track " << vp.id;
+    EXPECT_LT(vp.gate_failures, 2u) << "track " << vp.id;  // dropped at 2 in a row
+    if (vp.confident) {
+      ++confident;
+      EXPECT_LT(vp.sigma_deg, 0.5) << "track " << vp.id;
+    }
+  }
+  EXPECT_GE(confident, 2);
+  std::map<std::string, std::string> values;
+  for (const auto& kv : h.last_odometry_status_.values) values[kv.key] = kv.value;
+  ASSERT_TRUE(values.count("VP priors used"));
+  EXPECT_GT(std::stoi(values["VP priors used"]), options.frames / 2);
+  ASSERT_TRUE(values.count("VP tracks"));
+  EXPECT_EQ(std::stoi(values["VP tracks"]), static_cast<int>(h.last_vps_.vps.size()));
+  int track_keys = 0;
+  for (const auto& [key, value] : values)
+    track_keys += key.rfind("VP track ", 0) == 0 && value.find("sigma") != std::string::npos;
+  EXPECT_EQ(track_keys, static_cast<int>(h.last_vps_.vps.size()));
 }
 
 // Features projected from the scene: corners painted on the walls and segments along the walls'
