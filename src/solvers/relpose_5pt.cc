@@ -74,31 +74,35 @@ ZRow z_row(const Eigen::Matrix<double, 10, 10>& B, int top, int bottom) {
 // Gauss-Jordan elimination with partial pivoting of the left 10x10 block of C; B receives the
 // right block of the reduced system [I | B]. Hand-written because Eigen's blocked LU and triangular
 // solves cost more than the arithmetic at this size. Each step subtracts multiples of the pivot
-// column from whole columns, which are contiguous: fixed-size vector operations rather than a
-// scalar loop along strided rows (a third of the instructions).
+// column from whole columns, which are contiguous (fixed-size vector operations rather than a
+// scalar loop along strided rows), and rows are not swapped: each pivot row is remembered and
+// gathered into B at the end.
 bool eliminate_leading_monomials(Eigen::Matrix<double, 10, 20> M, Eigen::Matrix<double, 10, 10>* B) {
   using Column = Eigen::Matrix<double, 10, 1>;
+  int pivot_row[10];
+  bool used[10] = {};
   for (int k = 0; k < 10; ++k) {
-    int pivot = k;
-    double largest = std::abs(M(k, k));
-    for (int i = k + 1; i < 10; ++i) {
+    int pivot = -1;
+    double largest = -1.0;
+    for (int i = 0; i < 10; ++i) {
       const double v = std::abs(M(i, k));
-      if (v > largest) largest = v, pivot = i;
+      if (!used[i] && v > largest) largest = v, pivot = i;
     }
     if (!(largest > 0.0) || !std::isfinite(largest)) return false;
-    if (pivot != k) M.row(pivot).swap(M.row(k));
+    used[pivot] = true;
+    pivot_row[k] = pivot;
     // Multipliers of the pivot row for every other row; zero for the pivot row itself, which is
     // scaled instead.
-    const double inv = 1.0 / M(k, k);
+    const double inv = 1.0 / M(pivot, k);
     Column factors = M.col(k);
-    factors(k) = 0.0;
+    factors(pivot) = 0.0;
     for (int j = k + 1; j < 20; ++j) {
-      const double pivot_row_entry = M(k, j) * inv;
+      const double pivot_row_entry = M(pivot, j) * inv;
       M.col(j) -= pivot_row_entry * factors;
-      M(k, j) = pivot_row_entry;
+      M(pivot, j) = pivot_row_entry;
     }
   }
-  *B = M.rightCols<10>();
+  for (int k = 0; k < 10; ++k) B->row(k) = M.row(pivot_row[k]).rightCols<10>();
   return all_finite(*B);
 }
 
@@ -140,6 +144,38 @@ bool null_space_basis(Eigen::Matrix<double, 9, 5> A, Eigen::Matrix<double, 9, 4>
       basis->col(j) -= s * V.col(k);
     }
   return true;
+}
+
+// The ten cubic constraints on E = x X + y Y + z Z + W (the basis columns), in the monomial
+// order above: (2 E E^T - tr(E E^T) I) E = 0, nine rows, and det(E) = 0 (Nistér's Sec. 3.1).
+void cubic_constraints(const Eigen::Matrix<double, 9, 4>& basis,
+                       Eigen::Matrix<double, 10, 20>* C) {
+  Linear e[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) e[i][j] = basis.row(3 * i + j).transpose();
+  Quadratic EEt[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) {
+      EEt[i][j] = multiply(e[i][0], e[j][0]) + multiply(e[i][1], e[j][1]) +
+                  multiply(e[i][2], e[j][2]);
+      EEt[j][i] = EEt[i][j];
+    }
+  const Quadratic trace = EEt[0][0] + EEt[1][1] + EEt[2][2];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      Cubic row = Cubic::Zero();
+      for (int k = 0; k < 3; ++k) {
+        Quadratic m = 2.0 * EEt[i][k];
+        if (i == k) m -= trace;
+        multiply_add(m, e[k][j], &row);
+      }
+      C->row(3 * i + j) = row.transpose();
+    }
+  Cubic det = Cubic::Zero();
+  multiply_add(multiply(e[1][1], e[2][2]) - multiply(e[1][2], e[2][1]), e[0][0], &det);
+  multiply_add(multiply(e[1][2], e[2][0]) - multiply(e[1][0], e[2][2]), e[0][1], &det);
+  multiply_add(multiply(e[1][0], e[2][1]) - multiply(e[1][1], e[2][0]), e[0][2], &det);
+  C->row(9) = det.transpose();
 }
 
 // One Gauss-Newton step of (x, y, z) on the ten cubic constraints C m(x, y, z) = 0. The degree-10
@@ -184,35 +220,8 @@ int essential_5pt(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2, Eigen::M
   Eigen::Matrix<double, 9, 4> basis;
   if (!null_space_basis(At, &basis)) return 0;
 
-  Linear e[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) e[i][j] = basis.row(3 * i + j).transpose();
-
-  // Ten cubic constraints: det(E) = 0 and (2 E E^T - tr(E E^T) I) E = 0.
-  Quadratic EEt[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = i; j < 3; ++j) {
-      EEt[i][j] = multiply(e[i][0], e[j][0]) + multiply(e[i][1], e[j][1]) +
-                  multiply(e[i][2], e[j][2]);
-      EEt[j][i] = EEt[i][j];
-    }
-  const Quadratic trace = EEt[0][0] + EEt[1][1] + EEt[2][2];
-  Eigen::Matrix<double, 10, 20> C = Eigen::Matrix<double, 10, 20>::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      Cubic row = Cubic::Zero();
-      for (int k = 0; k < 3; ++k) {
-        Quadratic m = 2.0 * EEt[i][k];
-        if (i == k) m -= trace;
-        multiply_add(m, e[k][j], &row);
-      }
-      C.row(3 * i + j) = row.transpose();
-    }
-  Cubic det = Cubic::Zero();
-  multiply_add(multiply(e[1][1], e[2][2]) - multiply(e[1][2], e[2][1]), e[0][0], &det);
-  multiply_add(multiply(e[1][2], e[2][0]) - multiply(e[1][0], e[2][2]), e[0][1], &det);
-  multiply_add(multiply(e[1][0], e[2][1]) - multiply(e[1][1], e[2][0]), e[0][2], &det);
-  C.row(9) = det.transpose();
+  Eigen::Matrix<double, 10, 20> C;
+  cubic_constraints(basis, &C);
 
   // Gauss-Jordan on the first ten monomials: monomial_i + B.row(i) . rest = 0.
   Eigen::Matrix<double, 10, 10> B;
