@@ -25,16 +25,17 @@ constexpr double kNoParallax2 = kNoParallax * kNoParallax;
 // minimal solvers call this several times per candidate pose.
 int vote_of_rays(double rx, double ry, double rz, double qx, double qy, double qz,
                  const Eigen::Vector3d& t, double tt) {
-  const double nx = ry * qz - rz * qy, ny = rz * qx - rx * qz, nz = rx * qy - ry * qx;  // r x q
-  // lambda1 * r + t = lambda2 * q, so lambda1 ~ (q x t).n and lambda2 ~ (r x t).n, both / |n|^2.
-  const double d1 = (qy * t.z() - qz * t.y()) * nx + (qz * t.x() - qx * t.z()) * ny +
-                    (qx * t.y() - qy * t.x()) * nz;
-  const double d2 = (ry * t.z() - rz * t.y()) * nx + (rz * t.x() - rx * t.z()) * ny +
-                    (rx * t.y() - ry * t.x()) * nz;
-  const double nn = nx * nx + ny * ny + nz * nz;
+  // lambda1 * r + t = lambda2 * q, so with n = r x q, lambda1 ~ (q x t).n and lambda2 ~ (r x t).n,
+  // both / |n|^2. By the Binet-Cauchy identity these are (q.r)(q.t) - (q.q)(r.t) and
+  // (r.r)(q.t) - (q.r)(r.t), and |n|^2 = (r.r)(q.q) - (q.r)^2: five dot products, no cross
+  // products.
+  const double rr = rx * rx + ry * ry + rz * rz, qq = qx * qx + qy * qy + qz * qz;
+  const double qr = qx * rx + qy * ry + qz * rz;
+  const double qt = qx * t.x() + qy * t.y() + qz * t.z(), rt = rx * t.x() + ry * t.y() + rz * t.z();
+  const double d1 = qr * qt - qq * rt, d2 = rr * qt - qr * rt;
+  const double nn = rr * qq - qr * qr;
   // (|n|^2 |t| |q| |r|)^2
-  const double scale2 =
-      nn * nn * tt * (qx * qx + qy * qy + qz * qz) * (rx * rx + ry * ry + rz * rz);
+  const double scale2 = nn * nn * tt * qq * rr;
   if (!(scale2 > 0.0)) return 0;
   if (d1 * d1 < kNoParallax2 * scale2 || d2 * d2 < kNoParallax2 * scale2) return 0;
   if ((d1 > 0.0) != (d2 > 0.0)) return kConflict;
