@@ -6,16 +6,11 @@ namespace hybrid_vo {
 namespace {
 
 // Each witness votes +1 (t as given), -1 (t flipped), 0 (no information) or reports a conflict.
-constexpr int kConflict = 2;
+constexpr int kConflict = kCheiralityConflict;
 // Relative size under which a depth is considered infinite (no parallax): the sign is noise.
 constexpr double kNoParallax = 1e-12;
 
-int combine(int sign, int vote) {
-  if (vote == 0 || sign == kConflict) return sign;
-  if (vote == kConflict) return kConflict;
-  if (sign == 0) return vote;
-  return sign == vote ? sign : kConflict;
-}
+int combine(int sign, int vote) { return combine_cheirality_votes(sign, vote); }
 
 // The tests |d| < kNoParallax * scale below compare squares, which spares every square root.
 constexpr double kNoParallax2 = kNoParallax * kNoParallax;
@@ -25,21 +20,9 @@ constexpr double kNoParallax2 = kNoParallax * kNoParallax;
 // minimal solvers call this several times per candidate pose.
 int vote_of_rays(double rx, double ry, double rz, double qx, double qy, double qz,
                  const Eigen::Vector3d& t, double tt) {
-  // lambda1 * r + t = lambda2 * q, so with n = r x q, lambda1 ~ (q x t).n and lambda2 ~ (r x t).n,
-  // both / |n|^2. By the Binet-Cauchy identity these are (q.r)(q.t) - (q.q)(r.t) and
-  // (r.r)(q.t) - (q.r)(r.t), and |n|^2 = (r.r)(q.q) - (q.r)^2: five dot products, no cross
-  // products.
-  const double rr = rx * rx + ry * ry + rz * rz, qq = qx * qx + qy * qy + qz * qz;
-  const double qr = qx * rx + qy * ry + qz * rz;
-  const double qt = qx * t.x() + qy * t.y() + qz * t.z(), rt = rx * t.x() + ry * t.y() + rz * t.z();
-  const double d1 = qr * qt - qq * rt, d2 = rr * qt - qr * rt;
-  const double nn = rr * qq - qr * qr;
-  // (|n|^2 |t| |q| |r|)^2
-  const double scale2 = nn * nn * tt * qq * rr;
-  if (!(scale2 > 0.0)) return 0;
-  if (d1 * d1 < kNoParallax2 * scale2 || d2 * d2 < kNoParallax2 * scale2) return 0;
-  if ((d1 > 0.0) != (d2 > 0.0)) return kConflict;
-  return d1 > 0.0 ? 1 : -1;
+  return cheirality_vote(rx * rx + ry * ry + rz * rz, qx * qx + qy * qy + qz * qz,
+                         qx * rx + qy * ry + qz * rz, qx * t.x() + qy * t.y() + qz * t.z(),
+                         rx * t.x() + ry * t.y() + rz * t.z(), tt);
 }
 
 int vote_of_point(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double tt,

@@ -221,19 +221,20 @@ double root_bound(const double* monic, int degree) {
 
 // Largest real root of the monic cubic x^3 + e2 x^2 + e1 x + e0.
 double largest_cubic_root(double e2, double e1, double e0) {
-  const double P = e1 - e2 * e2 / 3.0;
-  const double Q = 2.0 * e2 * e2 * e2 / 27.0 - e2 * e1 / 3.0 + e0;
-  const double D = 0.25 * Q * Q + P * P * P / 27.0;
+  constexpr double kThird = 1.0 / 3.0;
+  const double P = e1 - e2 * e2 * kThird;
+  const double Q = 2.0 * e2 * e2 * e2 * (kThird * kThird * kThird) - e2 * e1 * kThird + e0;
+  const double D = 0.25 * Q * Q + P * P * P * (kThird * kThird * kThird);
   double t;
   if (D > 0.0) {
     const double u = std::cbrt(-0.5 * Q - std::copysign(std::sqrt(D), Q));
-    t = u != 0.0 ? u - P / (3.0 * u) : 0.0;
+    t = u != 0.0 ? u - P * kThird / u : 0.0;
   } else {
-    const double rho = std::sqrt(std::max(0.0, -P / 3.0));
+    const double rho = std::sqrt(std::max(0.0, -P * kThird));
     const double cos_arg = rho > 0.0 ? std::clamp(-0.5 * Q / (rho * rho * rho), -1.0, 1.0) : 0.0;
-    t = 2.0 * rho * std::cos(std::acos(cos_arg) / 3.0);
+    t = 2.0 * rho * std::cos(std::acos(cos_arg) * kThird);
   }
-  double x = t - e2 / 3.0;
+  double x = t - e2 * kThird;
   for (int i = 0; i < 2; ++i) {
     const double f = ((x + e2) * x + e1) * x + e0;
     const double df = (3.0 * x + 2.0 * e2) * x + e1;
@@ -320,18 +321,19 @@ int isolate_and_polish_roots(const Chain& chain, const double* monic, int degree
 }  // namespace
 
 int real_roots_quartic(const double* c, double* roots) {
-  double scale = 0.0;
-  for (int i = 0; i <= 4; ++i) {
-    if (!std::isfinite(c[i])) return 0;
-    scale = std::max(scale, std::abs(c[i]));
-  }
+  // A non-finite coefficient makes the sum non-finite (or it overflows near 1e308).
+  if (!std::isfinite(c[0] + c[1] + c[2] + c[3] + c[4])) return 0;
+  const double scale = std::max(std::max(std::max(std::abs(c[0]), std::abs(c[1])),
+                                         std::max(std::abs(c[2]), std::abs(c[3]))),
+                                std::abs(c[4]));
   // A leading coefficient below 1e-3 of the largest means a root beyond ~1e3 times the others:
   // dividing by it, Ferrari's resolvent loses the small roots' digits and turns close pairs
   // complex (most 3-0-1 failures on random instances, where tan(phi / 2) ~ 1e4 is common).
   // The Sturm path keeps them: with a threshold of 1e-8, 3-0-1 failed on 53 of 1M instances,
   // with 1e-3 on 3 (with 1e-2 on 1, for 7 % more instructions).
   if (!(std::abs(c[4]) > 1e-3 * scale)) return real_roots(c, 4, roots);
-  const double a = c[3] / c[4], b = c[2] / c[4], cc = c[1] / c[4], d = c[0] / c[4];
+  const double inv = 1.0 / c[4];
+  const double a = c[3] * inv, b = c[2] * inv, cc = c[1] * inv, d = c[0] * inv;
   // x = y - a/4 gives y^4 + p y^2 + q y + r.
   const double a2 = a * a;
   const double p = b - 3.0 * a2 / 8.0;
@@ -372,7 +374,8 @@ int real_roots_quartic(const double* c, double* roots) {
     }
     roots[i] = x;
   }
-  std::sort(roots, roots + n);
+  for (int i = 1; i < n; ++i)  // insertion sort of at most four
+    for (int j = i; j > 0 && roots[j] < roots[j - 1]; --j) std::swap(roots[j], roots[j - 1]);
   return n;
 }
 

@@ -31,29 +31,66 @@ QuadraticVector constraint(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return q;
 }
 
-// Null vector of the three constraint rows from their best-conditioned pair, unit length; false
-// when all three pairs are parallel.
-bool unit_null_vector(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                      Eigen::Vector3d* t) {
+// Null vector of the three constraint rows from their best-conditioned pair, not normalised
+// (cheirality needs only its direction); its squared norm, 0 when all three pairs are parallel.
+double null_vector(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                   Eigen::Vector3d* t) {
   Eigen::Vector3d best = cross(a, b);
   double best_norm2 = best.squaredNorm();
   const Eigen::Vector3d ac = cross(a, c), bc = cross(b, c);
   const double ac_norm2 = ac.squaredNorm(), bc_norm2 = bc.squaredNorm();
   if (ac_norm2 > best_norm2) best = ac, best_norm2 = ac_norm2;
   if (bc_norm2 > best_norm2) best = bc, best_norm2 = bc_norm2;
-  if (!(best_norm2 > 0.0) || !std::isfinite(best_norm2)) return false;
-  *t = best / std::sqrt(best_norm2);
-  return true;
+  if (!(best_norm2 > 0.0) || !std::isfinite(best_norm2)) return 0.0;
+  *t = best;
+  return best_norm2;
 }
 
-// Keeps the candidate when some sign of t puts the three matches in front of both cameras,
-// decided on the rays R_y q1 and q2 of the upright frame.
-bool orient(const Eigen::Vector3d* q1, const Eigen::Vector3d* q2, UprightPose* pose) {
-  const double c = pose->cos_phi, s = pose->sin_phi;
-  Eigen::Vector3d r[3];
-  for (int i = 0; i < 3; ++i)
-    r[i] = {c * q1[i].x() - s * q1[i].z(), q1[i].y(), s * q1[i].x() + c * q1[i].z()};
-  return orient_translation_rays(r, q2, 3, &pose->t);
+// What the cheirality votes of every candidate share: with r = R_y q1 (the ray of camera 1 in the
+// upright frame of camera 2), |r|^2 = |q1|^2, q2 . r = c alpha + s beta + gamma, and
+// r . t = q1 . (R_y^T t).
+struct Matches {
+  const Eigen::Vector3d* q1;
+  const Eigen::Vector3d* q2;
+  double rr[3], qq[3], alpha[3], beta[3], gamma[3];
+};
+
+Matches prepare(const Eigen::Vector3d* q1, const Eigen::Vector3d* q2) {
+  Matches m;
+  m.q1 = q1;
+  m.q2 = q2;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d &a = q1[i], &b = q2[i];
+    m.rr[i] = a.squaredNorm();
+    m.qq[i] = b.squaredNorm();
+    m.alpha[i] = b.x() * a.x() + b.z() * a.z();
+    m.beta[i] = b.z() * a.x() - b.x() * a.z();
+    m.gamma[i] = b.y() * a.y();
+  }
+  return m;
+}
+
+// Completes a candidate from its null vector t, |t|^2 = t_norm2: keeps it when some sign of t puts
+// the three matches in front of both cameras (the votes of orient_translation_rays), or always
+// when not orienting; then t to unit length.
+inline bool finish(const Matches& m, bool orient, double t_norm2, UprightPose* pose) {
+  Eigen::Vector3d& t = pose->t;
+  if (orient) {
+    const double c = pose->cos_phi, s = pose->sin_phi;
+    // R_y^T t, for r . t.
+    const double ux = c * t.x() + s * t.z(), uz = c * t.z() - s * t.x();
+    int sign = 0;
+    for (int i = 0; i < 3 && sign != kCheiralityConflict; ++i) {
+      const Eigen::Vector3d &a = m.q1[i], &b = m.q2[i];
+      const double qr = c * m.alpha[i] + s * m.beta[i] + m.gamma[i];
+      const double qt = b.dot(t), rt = a.x() * ux + a.y() * t.y() + a.z() * uz;
+      sign = combine_cheirality_votes(sign, cheirality_vote(m.rr[i], m.qq[i], qr, qt, rt, t_norm2));
+    }
+    if (sign == kCheiralityConflict) return false;
+    if (sign < 0) t = -t;
+  }
+  t *= 1.0 / std::sqrt(t_norm2);
+  return true;
 }
 
 }  // namespace
@@ -87,18 +124,20 @@ int upright_relpose_3pt(const Eigen::Vector3d* q1, const Eigen::Vector3d* q2, bo
   // High and low coefficients are exact from either end; the middle one is averaged.
   const double quartic[5] = {s0, s1, 0.5 * ((s4 - s6) + (s2 - s0)), s5, s6};
 
+  Matches m;
+  if (orient_t) m = prepare(q1, q2);
   double ys[4];
   const int num_roots = real_roots_quartic(quartic, ys);
   int count = 0;
   for (int r = 0; r < num_roots; ++r) {
     const double y = ys[r];
     UprightPose& pose = poses[count];
-    if (!unit_null_vector(a[0].at(y), a[1].at(y), a[2].at(y), &pose.t)) continue;
+    const double t_norm2 = null_vector(a[0].at(y), a[1].at(y), a[2].at(y), &pose.t);
+    if (t_norm2 == 0.0) continue;
     const double w = 1.0 / (1.0 + y * y);
     pose.cos_phi = (1.0 - y * y) * w;
     pose.sin_phi = 2.0 * y * w;
-    if (orient_t && !orient(q1, q2, &pose)) continue;
-    ++count;
+    if (finish(m, orient_t, t_norm2, &pose)) ++count;
   }
   // y = tan(phi / 2) cannot express phi = pi; it shows up as a vanishing leading coefficient.
   double scale = 0.0;
@@ -106,10 +145,11 @@ int upright_relpose_3pt(const Eigen::Vector3d* q1, const Eigen::Vector3d* q2, bo
   if (std::abs(quartic[4]) <= 1e-12 * scale && count < 4) {
     // At y -> infinity, a(y) / y^2 -> a2.
     UprightPose& pose = poses[count];
-    if (unit_null_vector(a[0].c[2], a[1].c[2], a[2].c[2], &pose.t)) {
+    const double t_norm2 = null_vector(a[0].c[2], a[1].c[2], a[2].c[2], &pose.t);
+    if (t_norm2 > 0.0) {
       pose.cos_phi = -1.0;
       pose.sin_phi = 0.0;
-      if (!orient_t || orient(q1, q2, &pose)) ++count;
+      if (finish(m, orient_t, t_norm2, &pose)) ++count;
     }
   }
   return count;
