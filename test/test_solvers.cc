@@ -310,6 +310,56 @@ TEST(HomographyFromPointsAndLines, DegenerateMixesAreRejected) {
   EXPECT_FALSE(homography_from_points_and_lines(y1, y2, 3, s1, s2, 1, &estimate));
 }
 
+// The written-out 4-0-0 DLT is the general projective-frame map on centred points: the same
+// homography to rounding, and the same rejections (every collinear triple, either image; NaN).
+TEST(Homography4pt, AgreesWithTheGeneralMapAndRejectsCollinearTriples) {
+  std::mt19937_64 rng(804);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  int agree = 0;
+  const int trials = 2000;
+  for (int trial = 0; trial < trials; ++trial) {
+    const Eigen::Matrix3d H = random_homography(rng);
+    Eigen::Vector2d x1[4], x2[4];
+    Eigen::Vector3d a[4], b[4];
+    const Eigen::Vector2d shift(u(rng), u(rng));
+    for (int i = 0; i < 4; ++i) {
+      x1[i] = Eigen::Vector2d(u(rng), u(rng)) + shift;
+      x2[i] = apply_homography(H, x1[i]);
+      a[i] = homogeneous(x1[i]);
+      b[i] = homogeneous(x2[i]);
+    }
+    Eigen::Matrix3d fast, general;
+    const bool ok_fast = homography_4pt(x1, x2, &fast);
+    ASSERT_EQ(ok_fast, homography_from_4_correspondences(a, b, &general)) << trial;
+    if (!ok_fast) continue;
+    EXPECT_NEAR(fast.norm(), 1.0, 1e-12);
+    if (homography_distance(fast, H) < 1e-10 && homography_distance(fast, general) < 1e-10)
+      ++agree;
+  }
+  EXPECT_GE(agree, 0.995 * trials);
+
+  const Eigen::Matrix3d H = random_homography(rng);
+  const Eigen::Vector2d x1[4] = {{0.1, 0.2}, {-0.3, 0.1}, {0.2, -0.4}, {0.5, 0.4}};
+  Eigen::Vector2d x2[4];
+  for (int i = 0; i < 4; ++i) x2[i] = apply_homography(H, x1[i]);
+  Eigen::Matrix3d estimate;
+  ASSERT_TRUE(homography_4pt(x1, x2, &estimate));
+  EXPECT_LT(homography_distance(estimate, H), 1e-12);
+  for (int skip = 0; skip < 4; ++skip) {
+    for (int side = 0; side < 2; ++side) {
+      Eigen::Vector2d c[4] = {x1[0], x1[1], x1[2], x1[3]}, d[4] = {x2[0], x2[1], x2[2], x2[3]};
+      Eigen::Vector2d* v = side == 0 ? c : d;
+      const int i = (skip + 1) % 4, j = (skip + 2) % 4, k = (skip + 3) % 4;
+      v[k] = 0.3 * v[i] + 0.7 * v[j];
+      EXPECT_FALSE(homography_4pt(c, d, &estimate)) << skip << " " << side;
+    }
+  }
+  Eigen::Vector2d with_nan[4] = {x1[0], x1[1], Eigen::Vector2d(NAN, 0.0), x1[3]};
+  EXPECT_FALSE(homography_4pt(with_nan, x2, &estimate));
+  Eigen::Vector2d with_inf[4] = {x1[0], x1[1], x1[2], Eigen::Vector2d(INFINITY, 1.0)};
+  EXPECT_FALSE(homography_4pt(x1, with_inf, &estimate));
+}
+
 TEST(SolverTable, ThirteenConfigurationsInPaperOrder) {
   const auto& table = solver_table();
   ASSERT_EQ(table.size(), 13u);

@@ -6,16 +6,11 @@ namespace hybrid_vo {
 namespace {
 
 // Each witness votes +1 (t as given), -1 (t flipped), 0 (no information) or reports a conflict.
-constexpr int kConflict = 2;
+constexpr int kConflict = kCheiralityConflict;
 // Relative size under which a depth is considered infinite (no parallax): the sign is noise.
 constexpr double kNoParallax = 1e-12;
 
-int combine(int sign, int vote) {
-  if (vote == 0 || sign == kConflict) return sign;
-  if (vote == kConflict) return kConflict;
-  if (sign == 0) return vote;
-  return sign == vote ? sign : kConflict;
-}
+int combine(int sign, int vote) { return combine_cheirality_votes(sign, vote); }
 
 // The tests |d| < kNoParallax * scale below compare squares, which spares every square root.
 constexpr double kNoParallax2 = kNoParallax * kNoParallax;
@@ -25,20 +20,9 @@ constexpr double kNoParallax2 = kNoParallax * kNoParallax;
 // minimal solvers call this several times per candidate pose.
 int vote_of_rays(double rx, double ry, double rz, double qx, double qy, double qz,
                  const Eigen::Vector3d& t, double tt) {
-  const double nx = ry * qz - rz * qy, ny = rz * qx - rx * qz, nz = rx * qy - ry * qx;  // r x q
-  // lambda1 * r + t = lambda2 * q, so lambda1 ~ (q x t).n and lambda2 ~ (r x t).n, both / |n|^2.
-  const double d1 = (qy * t.z() - qz * t.y()) * nx + (qz * t.x() - qx * t.z()) * ny +
-                    (qx * t.y() - qy * t.x()) * nz;
-  const double d2 = (ry * t.z() - rz * t.y()) * nx + (rz * t.x() - rx * t.z()) * ny +
-                    (rx * t.y() - ry * t.x()) * nz;
-  const double nn = nx * nx + ny * ny + nz * nz;
-  // (|n|^2 |t| |q| |r|)^2
-  const double scale2 =
-      nn * nn * tt * (qx * qx + qy * qy + qz * qz) * (rx * rx + ry * ry + rz * rz);
-  if (!(scale2 > 0.0)) return 0;
-  if (d1 * d1 < kNoParallax2 * scale2 || d2 * d2 < kNoParallax2 * scale2) return 0;
-  if ((d1 > 0.0) != (d2 > 0.0)) return kConflict;
-  return d1 > 0.0 ? 1 : -1;
+  return cheirality_vote(rx * rx + ry * ry + rz * rz, qx * qx + qy * qy + qz * qz,
+                         qx * rx + qy * ry + qz * rz, qx * t.x() + qy * t.y() + qz * t.z(),
+                         rx * t.x() + ry * t.y() + rz * t.z(), tt);
 }
 
 int vote_of_point(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double tt,

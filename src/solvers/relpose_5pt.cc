@@ -1,9 +1,9 @@
 #include "hybrid_vo/solvers/relpose_5pt.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/LU>
-#include <Eigen/QR>
 
 #include "hybrid_vo/geometry/essential.h"
 #include "hybrid_vo/geometry/homogeneous.h"
@@ -73,25 +73,109 @@ ZRow z_row(const Eigen::Matrix<double, 10, 10>& B, int top, int bottom) {
 
 // Gauss-Jordan elimination with partial pivoting of the left 10x10 block of C; B receives the
 // right block of the reduced system [I | B]. Hand-written because Eigen's blocked LU and triangular
-// solves cost more than the arithmetic at this size.
+// solves cost more than the arithmetic at this size. Each step subtracts multiples of the pivot
+// column from whole columns, which are contiguous (fixed-size vector operations rather than a
+// scalar loop along strided rows), and rows are not swapped: each pivot row is remembered and
+// gathered into B at the end.
 bool eliminate_leading_monomials(Eigen::Matrix<double, 10, 20> M, Eigen::Matrix<double, 10, 10>* B) {
+  using Column = Eigen::Matrix<double, 10, 1>;
+  int pivot_row[10];
+  bool used[10] = {};
   for (int k = 0; k < 10; ++k) {
-    int pivot = k;
-    for (int i = k + 1; i < 10; ++i)
-      if (std::abs(M(i, k)) > std::abs(M(pivot, k))) pivot = i;
-    if (!(std::abs(M(pivot, k)) > 0.0) || !std::isfinite(M(pivot, k))) return false;
-    if (pivot != k) M.row(pivot).swap(M.row(k));
-    const double inv = 1.0 / M(k, k);
-    for (int j = k + 1; j < 20; ++j) M(k, j) *= inv;
+    int pivot = -1;
+    double largest = -1.0;
     for (int i = 0; i < 10; ++i) {
-      if (i == k) continue;
-      const double f = M(i, k);
-      if (f == 0.0) continue;
-      for (int j = k + 1; j < 20; ++j) M(i, j) -= f * M(k, j);
+      const double v = std::abs(M(i, k));
+      if (!used[i] && v > largest) largest = v, pivot = i;
+    }
+    if (!(largest > 0.0) || !std::isfinite(largest)) return false;
+    used[pivot] = true;
+    pivot_row[k] = pivot;
+    // Multipliers of the pivot row for every other row; zero for the pivot row itself, which is
+    // scaled instead.
+    const double inv = 1.0 / M(pivot, k);
+    Column factors = M.col(k);
+    factors(pivot) = 0.0;
+    for (int j = k + 1; j < 20; ++j) {
+      const double pivot_row_entry = M(pivot, j) * inv;
+      M.col(j) -= pivot_row_entry * factors;
+      M(pivot, j) = pivot_row_entry;
     }
   }
-  *B = M.rightCols<10>();
+  for (int k = 0; k < 10; ++k) B->row(k) = M.row(pivot_row[k]).rightCols<10>();
   return all_finite(*B);
+}
+
+// Orthonormal basis of the 4-dimensional null space of the five constraints (the columns of
+// At): the last four columns of Q in the Householder QR of At (Golub and Van Loan, Sec. 5.2),
+// written out for the fixed size; Eigen's QR and the application of its Q cost four times as
+// many instructions here. False when the constraints are dependent (|R_ii| below 1e-10 of the
+// largest).
+bool null_space_basis(Eigen::Matrix<double, 9, 5> A, Eigen::Matrix<double, 9, 4>* basis) {
+  // Reflector k is I - beta_k v_k v_k^T with v_k zero above row k.
+  Eigen::Matrix<double, 9, 5> V = Eigen::Matrix<double, 9, 5>::Zero();
+  double beta[5];
+  double largest = 0.0, smallest = INFINITY;
+  for (int k = 0; k < 5; ++k) {
+    double tail = 0.0;  // squared norm below the diagonal
+    for (int i = k + 1; i < 9; ++i) tail += A(i, k) * A(i, k);
+    const double head = A(k, k);
+    const double norm = std::sqrt(head * head + tail);
+    // alpha = -sign(head) |x| avoids cancellation in v_k = x - alpha e_k.
+    const double alpha = head >= 0.0 ? -norm : norm;
+    largest = std::max(largest, norm);
+    smallest = std::min(smallest, norm);  // |R_kk|
+    for (int i = k + 1; i < 9; ++i) V(i, k) = A(i, k);
+    V(k, k) = head - alpha;
+    const double vv = V(k, k) * V(k, k) + tail;
+    beta[k] = vv > 0.0 ? 2.0 / vv : 0.0;
+    for (int j = k + 1; j < 5; ++j) {
+      const double s = beta[k] * V.col(k).dot(A.col(j));
+      A.col(j) -= s * V.col(k);
+    }
+  }
+  if (!(smallest > 1e-10 * largest)) return false;  // repeated or otherwise dependent constraints
+  // Q [0; I] = H_0 H_1 ... H_4 [0; I], applying H_4 first.
+  basis->setZero();
+  basis->bottomRows<4>().setIdentity();
+  for (int k = 4; k >= 0; --k)
+    for (int j = 0; j < 4; ++j) {
+      const double s = beta[k] * V.col(k).dot(basis->col(j));
+      basis->col(j) -= s * V.col(k);
+    }
+  return true;
+}
+
+// The ten cubic constraints on E = x X + y Y + z Z + W (the basis columns), in the monomial
+// order above: (2 E E^T - tr(E E^T) I) E = 0, nine rows, and det(E) = 0 (Nistér's Sec. 3.1).
+void cubic_constraints(const Eigen::Matrix<double, 9, 4>& basis,
+                       Eigen::Matrix<double, 10, 20>* C) {
+  Linear e[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) e[i][j] = basis.row(3 * i + j).transpose();
+  Quadratic EEt[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j) {
+      EEt[i][j] = multiply(e[i][0], e[j][0]) + multiply(e[i][1], e[j][1]) +
+                  multiply(e[i][2], e[j][2]);
+      EEt[j][i] = EEt[i][j];
+    }
+  const Quadratic trace = EEt[0][0] + EEt[1][1] + EEt[2][2];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      Cubic row = Cubic::Zero();
+      for (int k = 0; k < 3; ++k) {
+        Quadratic m = 2.0 * EEt[i][k];
+        if (i == k) m -= trace;
+        multiply_add(m, e[k][j], &row);
+      }
+      C->row(3 * i + j) = row.transpose();
+    }
+  Cubic det = Cubic::Zero();
+  multiply_add(multiply(e[1][1], e[2][2]) - multiply(e[1][2], e[2][1]), e[0][0], &det);
+  multiply_add(multiply(e[1][2], e[2][0]) - multiply(e[1][0], e[2][2]), e[0][1], &det);
+  multiply_add(multiply(e[1][0], e[2][1]) - multiply(e[1][1], e[2][0]), e[0][2], &det);
+  C->row(9) = det.transpose();
 }
 
 // One Gauss-Newton step of (x, y, z) on the ten cubic constraints C m(x, y, z) = 0. The degree-10
@@ -133,48 +217,11 @@ int essential_5pt(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2, Eigen::M
       for (int k = 0; k < 3; ++k) At(3 * j + k, i) = q(j) * p(k);
   }
   if (!all_finite(At)) return 0;
-  const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 5>> qr(At);
-  const auto& R = qr.matrixQR();
-  double largest = 0.0, smallest = INFINITY;
-  for (int i = 0; i < 5; ++i) {
-    largest = std::max(largest, std::abs(R(i, i)));
-    smallest = std::min(smallest, std::abs(R(i, i)));
-  }
-  if (!(smallest > 1e-10 * largest)) return 0;  // repeated or otherwise dependent constraints
-  // Columns X, Y, Z, W: the last four columns of Q, without forming Q.
-  Eigen::Matrix<double, 9, 4> basis = Eigen::Matrix<double, 9, 4>::Zero();
-  basis.bottomRows<4>().setIdentity();
-  basis.applyOnTheLeft(qr.householderQ());
+  Eigen::Matrix<double, 9, 4> basis;
+  if (!null_space_basis(At, &basis)) return 0;
 
-  Linear e[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) e[i][j] = basis.row(3 * i + j).transpose();
-
-  // Ten cubic constraints: det(E) = 0 and (2 E E^T - tr(E E^T) I) E = 0.
-  Quadratic EEt[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = i; j < 3; ++j) {
-      EEt[i][j] = multiply(e[i][0], e[j][0]) + multiply(e[i][1], e[j][1]) +
-                  multiply(e[i][2], e[j][2]);
-      EEt[j][i] = EEt[i][j];
-    }
-  const Quadratic trace = EEt[0][0] + EEt[1][1] + EEt[2][2];
-  Eigen::Matrix<double, 10, 20> C = Eigen::Matrix<double, 10, 20>::Zero();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      Cubic row = Cubic::Zero();
-      for (int k = 0; k < 3; ++k) {
-        Quadratic m = 2.0 * EEt[i][k];
-        if (i == k) m -= trace;
-        multiply_add(m, e[k][j], &row);
-      }
-      C.row(3 * i + j) = row.transpose();
-    }
-  Cubic det = Cubic::Zero();
-  multiply_add(multiply(e[1][1], e[2][2]) - multiply(e[1][2], e[2][1]), e[0][0], &det);
-  multiply_add(multiply(e[1][2], e[2][0]) - multiply(e[1][0], e[2][2]), e[0][1], &det);
-  multiply_add(multiply(e[1][0], e[2][1]) - multiply(e[1][1], e[2][0]), e[0][2], &det);
-  C.row(9) = det.transpose();
+  Eigen::Matrix<double, 10, 20> C;
+  cubic_constraints(basis, &C);
 
   // Gauss-Jordan on the first ten monomials: monomial_i + B.row(i) . rest = 0.
   Eigen::Matrix<double, 10, 10> B;

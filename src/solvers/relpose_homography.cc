@@ -97,12 +97,80 @@ bool homography_from_3_correspondences_and_dual(const Eigen::Vector3d* a, const 
   return map_of_3_and_dual(a, b, f, g, G) && normalise(G);
 }
 
+bool homography_4pt(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2, Eigen::Matrix3d* H) {
+  // map_of_4 for points (x, y, 1), written out: every cross product of two such points is
+  // (y_a - y_b, x_b - x_a, x_a y_b - y_a x_b), two products instead of six. Centred as in
+  // homography_from_points_and_lines.
+  const double c1x = 0.25 * (x1[0].x() + x1[1].x() + x1[2].x() + x1[3].x());
+  const double c1y = 0.25 * (x1[0].y() + x1[1].y() + x1[2].y() + x1[3].y());
+  const double c2x = 0.25 * (x2[0].x() + x2[1].x() + x2[2].x() + x2[3].x());
+  const double c2y = 0.25 * (x2[0].y() + x2[1].y() + x2[2].y() + x2[3].y());
+  double ax[4], ay[4], bx[4], by[4], na[4], nb[4];
+  for (int i = 0; i < 4; ++i) {
+    ax[i] = x1[i].x() - c1x;
+    ay[i] = x1[i].y() - c1y;
+    bx[i] = x2[i].x() - c2x;
+    by[i] = x2[i].y() - c2y;
+    na[i] = ax[i] * ax[i] + ay[i] * ay[i] + 1.0;
+    nb[i] = bx[i] * bx[i] + by[i] * by[i] + 1.0;
+  }
+  // Rows of adj[a0 a1 a2] (a1 x a2, a2 x a0, a0 x a1) and of adj[b0 b1 b2].
+  double A[3][3], B[3][3];
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    A[i][0] = ay[j] - ay[k];
+    A[i][1] = ax[k] - ax[j];
+    A[i][2] = ax[j] * ay[k] - ay[j] * ax[k];
+    B[i][0] = by[j] - by[k];
+    B[i][1] = bx[k] - bx[j];
+    B[i][2] = bx[j] * by[k] - by[j] * bx[k];
+  }
+  const double det_a = A[0][0] * ax[0] + A[0][1] * ay[0] + A[0][2];
+  const double det_b = B[0][0] * bx[0] + B[0][1] * by[0] + B[0][2];
+  double lambda[3], mu[3];
+  for (int i = 0; i < 3; ++i) {
+    lambda[i] = A[i][0] * ax[3] + A[i][1] * ay[3] + A[i][2];
+    mu[i] = B[i][0] * bx[3] + B[i][1] * by[3] + B[i][2];
+  }
+  if (!independent(det_a, na[0], na[1], na[2]) || !independent(det_b, nb[0], nb[1], nb[2]) ||
+      !independent(lambda[0], na[1], na[2], na[3]) || !independent(mu[0], nb[1], nb[2], nb[3]) ||
+      !independent(lambda[1], na[2], na[0], na[3]) || !independent(mu[1], nb[2], nb[0], nb[3]) ||
+      !independent(lambda[2], na[0], na[1], na[3]) || !independent(mu[2], nb[0], nb[1], nb[3]))
+    return false;
+  // G = B diag(d) adj(A) = sum_i d_i b_i adj(A).row(i), with b_i = (bx_i, by_i, 1).
+  const double d[3] = {mu[0] * lambda[1] * lambda[2], mu[1] * lambda[2] * lambda[0],
+                       mu[2] * lambda[0] * lambda[1]};
+  double G[3][3] = {};
+  for (int i = 0; i < 3; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double w = d[i] * A[i][c];
+      G[0][c] += bx[i] * w;
+      G[1][c] += by[i] * w;
+      G[2][c] += w;
+    }
+  // Undo the centring, H = T(c2)^-1 G T(c1), and scale to unit Frobenius norm.
+  for (int r = 0; r < 3; ++r) G[r][2] -= G[r][0] * c1x + G[r][1] * c1y;
+  for (int c = 0; c < 3; ++c) {
+    G[0][c] += c2x * G[2][c];
+    G[1][c] += c2y * G[2][c];
+  }
+  double norm2 = 0.0;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) norm2 += G[r][c] * G[r][c];
+  if (!(norm2 > 0.0) || !std::isfinite(norm2)) return false;
+  const double inv = 1.0 / std::sqrt(norm2);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) (*H)(r, c) = G[r][c] * inv;
+  return true;
+}
+
 bool homography_from_points_and_lines(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2,
                                       int num_points, const LineSegment* s1, const LineSegment* s2,
                                       int num_lines, Eigen::Matrix3d* H) {
   if (num_points < 0 || num_lines < 0 || num_points + num_lines != 4) return false;
   // Two points and two lines never fix H (README, "2-2-0 is degenerate").
   if (num_points == 2) return false;
+  if (num_points == 4) return homography_4pt(x1, x2, H);
   // Centred coordinates (as HZ2004 Sec. 4.4.4 normalises the DLT): the cross products then do
   // not cancel digits against the homogeneous 1.
   Eigen::Vector2d c1 = Eigen::Vector2d::Zero(), c2 = Eigen::Vector2d::Zero();

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <functional>
 #include <iostream>
 #include <memory>
 #include <random>
@@ -19,6 +18,7 @@
 #include "hybrid_vo/geometry/essential.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
+#include "hybrid_vo/solvers/relpose_homography.h"
 #include "hybrid_vo/synthetic/minimal_instances.h"
 
 #ifdef HYBRID_VO_HAVE_OPENGV
@@ -38,15 +38,21 @@ struct Arguments {
   std::string histograms_dir;
   std::string noise_dir;
   std::string only;  // one configuration code, e.g. 5-0-0; empty for all
+  std::string vp_signs = "both";  // 3-0-1 rows: "unknown", "known" or "both"
 };
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
-            << " [--instances N] [--seed S] [--only CONFIG] [--histograms DIR] [--noise-curve DIR]\n"
+            << " [--instances N] [--seed S] [--only CONFIG] [--vp-signs unknown|known|both]\n"
+               "       [--histograms DIR] [--noise-curve DIR]\n"
                "  Prints one CSV row per minimal configuration (paper Fig. 2), then OpenGV's\n"
-               "  five-point solvers on the same 5-0-0 instances, and their speed ratio.\n"
+               "  five-point solvers on the same 5-0-0 instances, and their speed ratio. 4-0-0 has a\n"
+               "  second row, the homography DLT alone (before decomposition); its error columns\n"
+               "  both hold the log10 distance of the unit-norm H to the true homography.\n"
                "  --only CONFIG      one configuration, e.g. 5-0-0 or 3-0-1 (peers run with 5-0-0);\n"
                "                     for profiling one solver under callgrind\n"
+               "  --vp-signs WHICH   3-0-1 rows: VP sign unknown (both signs tried), known, or both\n"
+               "                     rows (default); with --only 3-0-1, one setting under callgrind\n"
                "  --histograms DIR   log10 error histograms (CSV + PNG), as the paper's Fig. 3\n"
                "  --noise-curve DIR  median errors against pixel noise, raw and after local\n"
                "                     optimisation on 50 points (CSV + PNG), as its Figs. 4-5\n";
@@ -83,6 +89,14 @@ bool parse(int argc, char** argv, Arguments* args) {
       const char* v = value("--only");
       if (!v) return false;
       args->only = v;
+    } else if (a == "--vp-signs") {
+      const char* v = value("--vp-signs");
+      if (!v) return false;
+      args->vp_signs = v;
+      if (args->vp_signs != "unknown" && args->vp_signs != "known" && args->vp_signs != "both") {
+        std::cerr << "error: --vp-signs must be unknown, known or both, got '" << v << "'\n";
+        return false;
+      }
     } else if (a == "--histograms") {
       const char* v = value("--histograms");
       if (!v) return false;
@@ -108,11 +122,14 @@ struct Row {
   int instances = 0;
   std::vector<double> log_rot, log_trans;
   double fail_rate = 0.0, us_per_call = 0.0, mean_solutions = 0.0;
-  bool signs_known = false;  // the extra 3-0-1 row; left out of the histograms
+  // The extra 3-0-1 row (VP sign known) and the DLT row; left out of the histograms.
+  bool extra_row = false;
 };
 
-// Median over chunks of the mean time per call: robust to a noisy machine.
-double time_per_call_us(int count, const std::function<void(int)>& call) {
+// Median over chunks of the mean time per call: robust to a noisy machine. A template rather
+// than std::function: an indirect call per instance would be a sizeable share of the DLT row.
+template <typename Call>
+double time_per_call_us(int count, const Call& call) {
   const int chunk = std::max(10, std::min(1000, count / 50));
   std::vector<double> per_call;
   for (int start = 0; start + chunk <= count; start += chunk) {
@@ -164,10 +181,69 @@ Row bench_solver(const SolverInfo& info, const std::vector<MinimalInstance>& dat
   row.us_per_call = time_per_call_us(static_cast<int>(data.size()), [&](int i) {
     sink += solve_minimal(info.id, data[i].sample, &scratch);
   });
+  // Capacity reserved before the calls, as for the timed ones: callgrind's count of solve_minimal
+  // (README) then holds the solvers' work, not the vectors' growth.
   std::vector<RelativePoses> solutions(data.size());
-  for (size_t i = 0; i < data.size(); ++i) solve_minimal(info.id, data[i].sample, &solutions[i]);
+  for (size_t i = 0; i < data.size(); ++i) {
+    solutions[i].reserve(16);
+    solve_minimal(info.id, data[i].sample, &solutions[i]);
+  }
   score(solutions, data, &row);
   if (sink < 0) std::puts("");  // keeps the timed calls observable
+  return row;
+}
+
+// The plane's homography of a noiseless 4-0-0 instance from its truth: the first three points
+// triangulated with (R, t), the plane n . X = d through them, H = R + t n^T / d.
+Eigen::Matrix3d true_homography(const MinimalInstance& inst) {
+  const Eigen::Matrix3d& R = inst.truth.R;
+  const Eigen::Vector3d& t = inst.truth.t;
+  Eigen::Vector3d X[3];
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d r = R * homogeneous(inst.sample.x1[i]), q = homogeneous(inst.sample.x2[i]);
+    // lambda r + t ~ q: lambda (q x r) = -(q x t).
+    const Eigen::Vector3d qr = q.cross(r), qt = q.cross(t);
+    X[i] = -(qr.dot(qt) / qr.squaredNorm()) * homogeneous(inst.sample.x1[i]);
+  }
+  const Eigen::Vector3d n = (X[1] - X[0]).cross(X[2] - X[0]);
+  return R + t * n.transpose() / n.dot(X[0]);
+}
+
+// The homography DLT alone on the 4-0-0 instances: homography_from_points_and_lines with four
+// points, as relpose_homography calls it before orienting and decomposing H.
+Row bench_homography_dlt(const std::vector<MinimalInstance>& data) {
+  Row row;
+  row.id = SolverId::kHomography4pt;
+  row.config = solver_info(row.id).code;
+  row.solver = "homography DLT alone (homography_from_points_and_lines)";
+  row.extra_row = true;
+  double sink = 0.0;
+  row.us_per_call = time_per_call_us(static_cast<int>(data.size()), [&](int i) {
+    Eigen::Matrix3d H;
+    if (homography_from_points_and_lines(data[i].sample.x1.data(), data[i].sample.x2.data(), 4,
+                                         nullptr, nullptr, 0, &H))
+      sink += H(0, 0);
+  });
+  int failures = 0, found = 0;
+  for (const MinimalInstance& inst : data) {
+    Eigen::Matrix3d H;
+    double error = M_PI;
+    if (homography_from_points_and_lines(inst.sample.x1.data(), inst.sample.x2.data(), 4, nullptr,
+                                         nullptr, 0, &H)) {
+      ++found;
+      Eigen::Matrix3d truth = true_homography(inst);
+      truth /= truth.norm();
+      error = std::min((H - truth).norm(), (H + truth).norm());
+    }
+    if (!(error <= kFailThreshold)) ++failures;
+    const double log_error = std::max(kLog10Floor, std::log10(std::max(error, 1e-300)));
+    row.log_rot.push_back(log_error);
+    row.log_trans.push_back(log_error);
+  }
+  row.instances = static_cast<int>(data.size());
+  row.fail_rate = static_cast<double>(failures) / data.size();
+  row.mean_solutions = static_cast<double>(found) / data.size();
+  if (sink == 12345.0) std::puts("");  // keeps the timed calls observable
   return row;
 }
 
@@ -233,7 +309,7 @@ bool write_histograms(const std::string& dir, const std::vector<Row>& rows) {
   csv << "config,solver,error,bin_lo,bin_hi,count\n";
   std::vector<evaluation::PlotSeries> rot_series, trans_series;
   for (const Row& r : rows) {
-    if (r.signs_known) continue;
+    if (r.extra_row) continue;
     for (int kind = 0; kind < 2; ++kind) {
       const std::vector<double>& values = kind == 0 ? r.log_rot : r.log_trans;
       std::vector<int> counts(bins, 0);
@@ -361,6 +437,8 @@ int main(int argc, char** argv) {
     // sign known, as a tracked VP gives it; that row compares with upright 3-point solvers.
     for (const bool signs_known : {false, true}) {
       if (signs_known && info.id != SolverId::k1vp3pt) continue;
+      if (info.id == SolverId::k1vp3pt && args.vp_signs == (signs_known ? "unknown" : "known"))
+        continue;
       std::mt19937_64 rng(args.seed + static_cast<int>(info.id));
       MinimalInstanceOptions options;
       options.orient_vps = signs_known;
@@ -371,9 +449,13 @@ int main(int argc, char** argv) {
       rows.push_back(bench_solver(info, data));
       if (signs_known) {
         rows.back().solver += " (VP sign known)";
-        rows.back().signs_known = true;
+        rows.back().extra_row = true;
       }
       print_row(rows.back());
+      if (info.id == SolverId::kHomography4pt) {
+        rows.push_back(bench_homography_dlt(data));
+        print_row(rows.back());
+      }
       if (info.id == SolverId::k5pt) five_point_data = std::move(data);
     }
     if (info.id == SolverId::k5pt) five_point_us = rows.back().us_per_call;

@@ -23,6 +23,12 @@ bool homography_from_3_correspondences_and_dual(const Eigen::Vector3d* a, const 
                                                 const Eigen::Vector3d& f, const Eigen::Vector3d& g,
                                                 Eigen::Matrix3d* G);
 
+// Homography x2 ~ H x1 from four point matches in normalised coordinates, unit Frobenius norm:
+// homography_from_4_correspondences on the centred points, written out for points (x, y, 1)
+// (the 4-0-0 DLT; about a quarter of the general path's instructions). False when three points of
+// either image are (nearly) collinear, or for non-finite input.
+bool homography_4pt(const Eigen::Vector2d* x1, const Eigen::Vector2d* x2, Eigen::Matrix3d* H);
+
 // Homography from k point and 4 - k line matches of one plane (the minimal DLT, HZ2004 Sec. 4.1;
 // lines map as l1 ~ H^T l2, paper eq. 2), in normalised coordinates, unit Frobenius norm. 4-0-0
 // and 0-4-0 map four points or four lines, 3-1-0 and 1-3-0 three and one of the dual kind, after
