@@ -42,11 +42,19 @@ void KltTracker::reset() {
   points_.clear();
   motion_.clear();
   ids_.clear();
+  stamp_ = motion_dt_ = kNoStamp;
 }
 
 int KltTracker::num_tracks() const { return static_cast<int>(points_.size()); }
 
-std::vector<char> KltTracker::predict(std::vector<cv::Point2f>* next) const {
+double KltTracker::motion_scale(double stamp) const {
+  const double dt = stamp - stamp_;
+  // NaN (no stamps) and non-increasing stamps fail both tests and keep the plain prediction.
+  if (!(dt > 0.0) || !(motion_dt_ > 0.0)) return 1.0;
+  return std::min(kMaxMotionScale, dt / motion_dt_);
+}
+
+std::vector<char> KltTracker::predict(double motion_scale, std::vector<cv::Point2f>* next) const {
   const size_t n = points_.size();
   next->assign(points_.begin(), points_.end());
   std::vector<char> predicted(n, 0);
@@ -76,20 +84,22 @@ std::vector<char> KltTracker::predict(std::vector<cv::Point2f>* next) const {
                                    : cv::Point2f(median_of(&dx[c]), median_of(&dy[c]));
   }
   for (size_t i = 0; i < n; ++i) {
-    (*next)[i] += known(motion_[i]) ? motion_[i] : cell_motion[cell_of(points_[i])];
+    (*next)[i] +=
+        motion_scale * (known(motion_[i]) ? motion_[i] : cell_motion[cell_of(points_[i])]);
     predicted[i] = 1;
   }
   return predicted;
 }
 
-std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int64_t>* ids) {
-  std::vector<PointMatch> matches = track_existing(image, ids);
+std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int64_t>* ids,
+                                          double stamp) {
+  std::vector<PointMatch> matches = track_existing(image, ids, stamp);
   detect_new();
   return matches;
 }
 
-std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image,
-                                                   std::vector<int64_t>* ids) {
+std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image, std::vector<int64_t>* ids,
+                                                   double stamp) {
   std::vector<PointMatch> matches;
   if (ids) ids->clear();
   if (image.empty()) return matches;
@@ -104,7 +114,7 @@ std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image,
   if (!previous_.empty() && !points_.empty()) {
     const size_t n = points_.size();
     std::vector<cv::Point2f> predicted_at;
-    const std::vector<char> predicted = predict(&predicted_at);
+    const std::vector<char> predicted = predict(motion_scale(stamp), &predicted_at);
     const int short_levels =
         std::max(0, std::min(options_.predicted_pyramid_levels, options_.pyramid_levels));
     // Forward: short searches from the predictions; what they lose, and what has no prediction,
@@ -160,6 +170,9 @@ std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image,
     motion_ = std::move(kept_motion);
     ids_ = std::move(kept_ids);
   }
+  // The motions just measured span this time step (NaN without stamps).
+  motion_dt_ = stamp - stamp_;
+  stamp_ = stamp;
   size_ = gray.size();
   previous_ = std::move(pyramid);
   return matches;

@@ -276,7 +276,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       if (all_finite(input.external.points[i]))
         points[input.external.point_ids[i]] = input.external.points[i];
   } else if (tracking) {
-    klt_.track_existing(gray);
+    klt_.track_existing(gray, nullptr, input.stamp);
     points = klt_points();
     // The re-detection serves only the next frame: on the second thread after the segments,
     // while this one matches and estimates. `points` holds the tracked features until then.

@@ -141,7 +141,23 @@ int run(int argc, char** argv) {
   }
   std::vector<double> pose_errors, rotation_nees;
   evaluation::Trajectory estimate, truth;
-  auto frame_of = [](double stamp) { return static_cast<int>(std::lround((stamp - 1.0) / 0.1)); };
+  // Stamps from times.txt (1 s added, as kitti_to_bag does), so that a sequence with frames left
+  // out has the gaps a live camera's dropped frames leave; 10 Hz without the file.
+  std::vector<double> stamps;
+  {
+    std::vector<double> times;
+    std::string ignored;
+    if (datasets::read_kitti_times(dir + "/times.txt", &times, &ignored) &&
+        static_cast<int>(times.size()) >= frames)
+      for (int i = 0; i < frames; ++i) stamps.push_back(1.0 + times[i]);
+    else
+      for (int i = 0; i < frames; ++i) stamps.push_back(1.0 + 0.1 * i);
+  }
+  auto frame_of = [&](double stamp) {
+    const auto it = std::lower_bound(stamps.begin(), stamps.end(), stamp - 1e-6);
+    return it != stamps.end() && std::abs(*it - stamp) < 1e-6 ? static_cast<int>(it - stamps.begin())
+                                                              : -1;
+  };
 
   VisualOdometry vo(o);
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
@@ -153,7 +169,7 @@ int run(int argc, char** argv) {
     if (period_ms > 0.0)
       std::this_thread::sleep_until(run_start + std::chrono::microseconds(
                                                     static_cast<int64_t>(1000.0 * period_ms * i)));
-    input.stamp = 1.0 + 0.1 * i;
+    input.stamp = stamps[i];
     input.image = images[i];
     if (stereo) input.right_image = right_images[i];
     const double cpu_start = cpu_ms();

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -28,7 +29,9 @@ struct KltTrackerOptions {
   // search loses is searched for again the long way. The backward search of the
   // forward-backward check mirrors the forward one: it starts at the found position minus the
   // predicted motion. On KITTI this keeps 20 % more tracks that agree with the true epipolar
-  // geometry, half as many that do not, and costs a third less (see the README).
+  // geometry, half as many that do not, and costs a third less (see the README). Given frame
+  // stamps, the last motion is scaled by the ratio of the time steps, so that a dropped frame
+  // does not start the short search at half the true motion (up to kMaxMotionScale).
   bool predict_motion = true;
   int predicted_pyramid_levels = 1;
 };
@@ -37,14 +40,21 @@ struct KltTrackerOptions {
 // empty buckets; each feature keeps a stable id across frames.
 class KltTracker {
  public:
+  static constexpr double kNoStamp = std::numeric_limits<double>::quiet_NaN();
+  // A longer gap than this many of the last time steps is predicted as this many: beyond it the
+  // constant-velocity guess is worth less than the long search it would replace.
+  static constexpr double kMaxMotionScale = 4.0;
   explicit KltTracker(const KltTrackerOptions& options = {});
   // Tracks the current features into `image` (grayscale) and re-detects: track_existing, then
   // detect_new. Returns the matches between the previous frame and this one (pixels) and their
-  // track ids. The first call (or the first after reset) returns no matches.
-  std::vector<PointMatch> track(const cv::Mat& image, std::vector<int64_t>* ids = nullptr);
+  // track ids. The first call (or the first after reset) returns no matches. `stamp` (seconds,
+  // optional) scales the motion prediction when frames are not evenly spaced.
+  std::vector<PointMatch> track(const cv::Mat& image, std::vector<int64_t>* ids = nullptr,
+                                double stamp = kNoStamp);
   // The two halves of track, so that the re-detection, which only the next frame needs, can run
   // while the caller uses the matches. After track_existing, points() holds the tracked features.
-  std::vector<PointMatch> track_existing(const cv::Mat& image, std::vector<int64_t>* ids = nullptr);
+  std::vector<PointMatch> track_existing(const cv::Mat& image, std::vector<int64_t>* ids = nullptr,
+                                         double stamp = kNoStamp);
   // Fills the buckets of the last tracked image that have too few features; appends to points().
   void detect_new();
   void reset();
@@ -59,7 +69,10 @@ class KltTracker {
  private:
   // Where each feature of the previous frame is searched for in the next one; false where there
   // is no prediction (the search then starts at the feature itself and spans all levels).
-  std::vector<char> predict(std::vector<cv::Point2f>* next) const;
+  std::vector<char> predict(double motion_scale, std::vector<cv::Point2f>* next) const;
+  // Ratio of the time since the last frame to the time step its motions were measured over; 1
+  // without stamps.
+  double motion_scale(double stamp) const;
 
   KltTrackerOptions options_;
   cv::Size size_;
@@ -68,6 +81,8 @@ class KltTracker {
   std::vector<cv::Point2f> motion_;  // per feature: its last image motion, NaN when new
   std::vector<int64_t> ids_;
   int64_t next_id_ = 0;
+  double stamp_ = kNoStamp;         // of the last tracked frame
+  double motion_dt_ = kNoStamp;     // the time step motion_ was measured over
 };
 
 }  // namespace hybrid_vo
