@@ -5,15 +5,8 @@
 namespace hybrid_vo {
 namespace {
 
-// Each witness votes +1 (t as given), -1 (t flipped), 0 (no information) or reports a conflict.
-constexpr int kConflict = kCheiralityConflict;
-// Relative size under which a depth is considered infinite (no parallax): the sign is noise.
-constexpr double kNoParallax = 1e-12;
-
-int combine(int sign, int vote) { return combine_cheirality_votes(sign, vote); }
-
-// The tests |d| < kNoParallax * scale below compare squares, which spares every square root.
-constexpr double kNoParallax2 = kNoParallax * kNoParallax;
+// Each witness votes +1 (t as given), -1 (t flipped), 0 (no information) or reports a conflict
+// (cheirality_vote in the header); combine_cheirality_votes folds the votes.
 
 // One point match as rays in camera 2's frame (or any rotation of it, applied to all three):
 // r = R x1 and q = x2, each up to a positive scale; tt = |t|^2. Written out in scalars, since the
@@ -37,7 +30,8 @@ int vote_of_point(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double tt,
 // camera, as sign(numerator * denominator); the plane contains the baseline when num ~ 0. The
 // scales are squared.
 int vote_of_endpoint(double num, double num_scale2, double den, double den_scale2) {
-  if (!(num * num > kNoParallax2 * num_scale2) || !(den * den > kNoParallax2 * den_scale2))
+  if (!(num * num > kCheiralityNoParallax2 * num_scale2) ||
+      !(den * den > kCheiralityNoParallax2 * den_scale2))
     return 0;
   return (num > 0.0) == (den > 0.0) ? 1 : -1;
 }
@@ -52,14 +46,16 @@ int vote_of_segment(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, double t
   const double l2t = l2.dot(t);
   for (const Eigen::Vector2d* a : {&s1.p1, &s1.p2}) {
     const Eigen::Vector3d ra = R * homogeneous(*a);
-    sign = combine(sign, vote_of_endpoint(-l2t, n2 * tt, l2.dot(ra), n2 * ra.squaredNorm()));
+    sign = combine_cheirality_votes(
+        sign, vote_of_endpoint(-l2t, n2 * tt, l2.dot(ra), n2 * ra.squaredNorm()));
   }
   // Camera 2 endpoint b: depth = (l1.R^T t) / (l1.R^T b).
   const Eigen::Vector3d Rl1 = R * l1;
   const double l1t = Rl1.dot(t);
   for (const Eigen::Vector2d* b : {&s2.p1, &s2.p2}) {
     const Eigen::Vector3d hb = homogeneous(*b);
-    sign = combine(sign, vote_of_endpoint(l1t, n1 * tt, Rl1.dot(hb), n1 * hb.squaredNorm()));
+    sign = combine_cheirality_votes(
+        sign, vote_of_endpoint(l1t, n1 * tt, Rl1.dot(hb), n1 * hb.squaredNorm()));
   }
   return sign;
 }
@@ -88,10 +84,10 @@ bool orient_translation_rays(const Eigen::Vector3d* r, const Eigen::Vector3d* q,
                              Eigen::Vector3d* t) {
   int sign = 0;
   const double tt = t->squaredNorm();
-  for (int i = 0; i < n && sign != kConflict; ++i)
-    sign = combine(sign, vote_of_rays(r[i].x(), r[i].y(), r[i].z(), q[i].x(), q[i].y(), q[i].z(),
-                                      *t, tt));
-  if (sign == kConflict) return false;
+  for (int i = 0; i < n && sign != kCheiralityConflict; ++i)
+    sign = combine_cheirality_votes(
+        sign, vote_of_rays(r[i].x(), r[i].y(), r[i].z(), q[i].x(), q[i].y(), q[i].z(), *t, tt));
+  if (sign == kCheiralityConflict) return false;
   if (sign < 0) *t = -*t;
   return true;
 }
@@ -99,11 +95,11 @@ bool orient_translation_rays(const Eigen::Vector3d* r, const Eigen::Vector3d* q,
 bool orient_translation(const Eigen::Matrix3d& R, Eigen::Vector3d* t, const MatchView& matches) {
   int sign = 0;
   const double tt = t->squaredNorm();
-  for (int i = 0; i < matches.num_points && sign != kConflict; ++i)
-    sign = combine(sign, vote_of_point(R, *t, tt, matches.x1[i], matches.x2[i]));
-  for (int i = 0; i < matches.num_segments && sign != kConflict; ++i)
-    sign = combine(sign, vote_of_segment(R, *t, tt, matches.s1[i], matches.s2[i]));
-  if (sign == kConflict) return false;
+  for (int i = 0; i < matches.num_points && sign != kCheiralityConflict; ++i)
+    sign = combine_cheirality_votes(sign, vote_of_point(R, *t, tt, matches.x1[i], matches.x2[i]));
+  for (int i = 0; i < matches.num_segments && sign != kCheiralityConflict; ++i)
+    sign = combine_cheirality_votes(sign, vote_of_segment(R, *t, tt, matches.s1[i], matches.s2[i]));
+  if (sign == kCheiralityConflict) return false;
   if (sign < 0) *t = -*t;
   return true;
 }

@@ -36,18 +36,20 @@ bool orient_translation_rays(const Eigen::Vector3d* r, const Eigen::Vector3d* q,
 // t), -1 (with -t), 0 (no parallax: the match says nothing) or kCheiralityConflict (neither).
 // orient_translation and orient_translation_rays combine these votes.
 constexpr int kCheiralityConflict = 2;
+// Relative size under which a depth counts as infinite (no parallax): its sign is noise. The
+// tests compare squares, which spares the square roots.
+constexpr double kCheiralityNoParallax2 = 1e-12 * 1e-12;
 inline int cheirality_vote(double rr, double qq, double qr, double qt, double rt, double tt) {
   // lambda1 r + t = lambda2 q, so with n = r x q, lambda1 ~ (q x t).n and lambda2 ~ (r x t).n,
   // both / |n|^2. By the Binet-Cauchy identity these are (q.r)(q.t) - (q.q)(r.t) and
   // (r.r)(q.t) - (q.r)(r.t), and |n|^2 = (r.r)(q.q) - (q.r)^2: no cross products.
   const double d1 = qr * qt - qq * rt, d2 = rr * qt - qr * rt;
   const double nn = rr * qq - qr * qr;
-  // A depth below 1e-12 of (|n|^2 |t| |q| |r|) is infinite (no parallax), its sign noise; the
-  // test compares squares, which spares the square roots.
-  constexpr double kNoParallax2 = 1e-12 * 1e-12;
+  // Each depth relative to |n|^2 |t| |q| |r|.
   const double scale2 = nn * nn * tt * qq * rr;
   if (!(scale2 > 0.0)) return 0;
-  if (d1 * d1 < kNoParallax2 * scale2 || d2 * d2 < kNoParallax2 * scale2) return 0;
+  if (d1 * d1 < kCheiralityNoParallax2 * scale2 || d2 * d2 < kCheiralityNoParallax2 * scale2)
+    return 0;
   if ((d1 > 0.0) != (d2 > 0.0)) return kCheiralityConflict;
   return d1 > 0.0 ? 1 : -1;
 }
