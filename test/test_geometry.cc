@@ -12,6 +12,7 @@
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/geometry/rotation.h"
 #include "hybrid_vo/geometry/vanishing_point.h"
+#include "hybrid_vo/geometry/vp_covariance.h"
 
 namespace hybrid_vo {
 namespace {
@@ -297,4 +298,38 @@ TEST(VanishingPoint, LeastSquaresIntersection) {
 }
 
 }  // namespace
+// Segments through the image of a VP direction: its covariance lies in the tangent plane, grows
+// with the segment noise squared, shrinks with more segments, and needs two; as a measurement
+// it adds the VP scale's floor to the fit, and is the floor alone without a usable fit.
+TEST(VpCovariance, FitAndMeasurement) {
+  Eigen::Matrix3d K;
+  K << 500, 0, 320, 0, 500, 240, 0, 0, 1;
+  const Eigen::Vector3d d = Eigen::Vector3d(0.3, -0.1, 1.0).normalized();
+  const Eigen::Vector2d v = (K * d).hnormalized();
+  std::vector<LineSegment> segments;
+  for (const Eigen::Vector2d& p : {Eigen::Vector2d(50, 400), Eigen::Vector2d(600, 420),
+                                   Eigen::Vector2d(100, 60), Eigen::Vector2d(620, 30)})
+    segments.emplace_back(p, p + 0.5 * (v - p));
+  Eigen::Matrix3d C, C2, few;
+  ASSERT_TRUE(vp_direction_covariance(K, segments, d, 0.5, &C));
+  EXPECT_LT((C * d).norm(), 1e-12 * C.norm());
+  EXPECT_LT((C - C.transpose()).norm(), 1e-12 * C.norm());
+  EXPECT_GT(C.trace(), 0.0);
+  ASSERT_TRUE(vp_direction_covariance(K, segments, d, 1.0, &C2));
+  EXPECT_NEAR(C2.trace(), 4.0 * C.trace(), 1e-9 * C2.trace());
+  const std::vector<LineSegment> two(segments.begin(), segments.begin() + 2);
+  ASSERT_TRUE(vp_direction_covariance(K, two, d, 0.5, &few));
+  EXPECT_GT(few.trace(), C.trace());
+  const std::vector<LineSegment> one(segments.begin(), segments.begin() + 1);
+  EXPECT_FALSE(vp_direction_covariance(K, one, d, 0.5, &few));
+
+  const double floor = 0.2 * M_PI / 180.0;
+  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+  Eigen::Matrix3d M;
+  ASSERT_TRUE(vp_measurement_covariance(K, segments, d, 0.5, floor, &M));
+  EXPECT_LT((M - (C + floor * floor * P)).norm(), 1e-15);
+  EXPECT_FALSE(vp_measurement_covariance(K, one, d, 0.5, floor, &M));
+  EXPECT_LT((M - floor * floor * P).norm(), 1e-15);
+}
+
 }  // namespace hybrid_vo

@@ -160,14 +160,11 @@ double vp_prior_chi2(const HybridProblem& problem, const TwoViewMatches& matches
   for (int i = 0; i < problem.num_lines(); ++i)
     if (problem.line_vp[i] == k && problem.line_valid[i]) segments.push_back(matches.lines[i].s2);
   const Eigen::Vector3d& d2 = problem.d2[k];
-  // The segments' fit alone is optimistic (segments are not exactly straight, nor exactly
-  // parallel in the scene): the pair's VP scale, measured under this rotation, adds what the fit
-  // does not see, and the rotation's own error with it.
-  const double sigma = scales.vp_deg * kDegree;
-  Eigen::Matrix3d observed = sigma * sigma * (Eigen::Matrix3d::Identity() - d2 * d2.transpose());
-  Eigen::Matrix3d fit;
-  if (vp_direction_covariance(problem.camera2.K(), segments, d2, scales.line_vp_px, &fit))
-    observed += fit;
+  // The pair's VP scale, measured under this rotation, adds what the segments' fit does not see,
+  // and the rotation's own error with it.
+  Eigen::Matrix3d observed;
+  vp_measurement_covariance(problem.camera2.K(), segments, d2, scales.line_vp_px,
+                            scales.vp_deg * kDegree, &observed);
   // The prior carried into camera 2, with the rotation's own uncertainty: a left increment w
   // moves R p by -[R p]x w.
   const Eigen::Matrix3d J = -skew(predicted);

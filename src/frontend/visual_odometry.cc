@@ -30,13 +30,10 @@ std::vector<VpObservation> vp_observations(const Eigen::Matrix3d& K, const TwoVi
   for (size_t k = 0; k < m.vps.size(); ++k) {
     observations[k].direction = second_image ? m.vps[k].d2 : m.vps[k].d1;
     // Without a usable fit the covariance stays zero: the tracker's default sigma.
-    Eigen::Matrix3d fit;
-    if (!vp_direction_covariance(K, segments[k], observations[k].direction, sigma_px, &fit))
-      continue;
-    const Eigen::Vector3d d = observations[k].direction.normalized();
-    const double sigma = vp_sigma_deg * M_PI / 180.0;
-    observations[k].covariance =
-        fit + sigma * sigma * (Eigen::Matrix3d::Identity() - d * d.transpose());
+    Eigen::Matrix3d covariance;
+    if (vp_measurement_covariance(K, segments[k], observations[k].direction, sigma_px,
+                                  vp_sigma_deg * M_PI / 180.0, &covariance))
+      observations[k].covariance = covariance;
   }
   return observations;
 }

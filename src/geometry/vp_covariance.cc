@@ -23,6 +23,17 @@ Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& d) {
   return B;
 }
 
+bool vp_measurement_covariance(const Eigen::Matrix3d& K, const std::vector<LineSegment>& segments,
+                               const Eigen::Vector3d& direction, double sigma_px,
+                               double vp_sigma_rad, Eigen::Matrix3d* covariance) {
+  const Eigen::Vector3d d = direction.normalized();
+  *covariance = vp_sigma_rad * vp_sigma_rad * (Eigen::Matrix3d::Identity() - d * d.transpose());
+  Eigen::Matrix3d fit;
+  if (!vp_direction_covariance(K, segments, direction, sigma_px, &fit)) return false;
+  *covariance += fit;
+  return true;
+}
+
 bool vp_direction_covariance(const Eigen::Matrix3d& K, const std::vector<LineSegment>& segments,
                              const Eigen::Vector3d& direction, double sigma_px,
                              Eigen::Matrix3d* covariance) {

@@ -18,6 +18,14 @@ bool vp_direction_covariance(const Eigen::Matrix3d& K, const std::vector<LineSeg
                              const Eigen::Vector3d& direction, double sigma_px,
                              Eigen::Matrix3d* covariance);
 
+// The covariance of a detected VP direction as a measurement: vp_direction_covariance's fit, which
+// alone is optimistic (segments are not exactly straight, nor exactly parallel in the scene), plus
+// vp_sigma_rad^2 per tangent axis, the VP scale measured on the pair. Returns whether the fit was
+// usable; the floor is written either way.
+bool vp_measurement_covariance(const Eigen::Matrix3d& K, const std::vector<LineSegment>& segments,
+                               const Eigen::Vector3d& direction, double sigma_px,
+                               double vp_sigma_rad, Eigen::Matrix3d* covariance);
+
 // An orthonormal basis (3x2) of the plane orthogonal to the unit vector d.
 Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& d);
 
