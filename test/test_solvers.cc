@@ -165,6 +165,21 @@ Eigen::Matrix3d random_homography(std::mt19937_64& rng) {
   return H;
 }
 
+// Calls fit(c, d, skip, side) for each of the four correspondences a_k <-> b_k moved onto the line
+// of two others, in image 1 (side 0) or image 2: the collinear triples a 4-point map must reject.
+template <typename Vector, typename Fit>
+void for_each_collinear_triple(const Vector* a, const Vector* b, Fit fit) {
+  for (int skip = 0; skip < 4; ++skip) {
+    for (int side = 0; side < 2; ++side) {
+      Vector c[4] = {a[0], a[1], a[2], a[3]}, d[4] = {b[0], b[1], b[2], b[3]};
+      Vector* v = side == 0 ? c : d;
+      const int i = (skip + 1) % 4, j = (skip + 2) % 4, k = (skip + 3) % 4;
+      v[k] = 0.3 * v[i] + 0.7 * v[j];
+      fit(c, d, skip, side);
+    }
+  }
+}
+
 Eigen::Vector2d apply_homography(const Eigen::Matrix3d& H, const Eigen::Vector2d& x) {
   return (H * homogeneous(x)).hnormalized();
 }
@@ -208,15 +223,10 @@ TEST(HomographyFromCorrespondences, CollinearTriplesAndIncidencesAreRejected) {
   Eigen::Matrix3d H;
   ASSERT_TRUE(homography_from_4_correspondences(a, b, &H));
   // Every triple, in either image.
-  for (int skip = 0; skip < 4; ++skip) {
-    for (int side = 0; side < 2; ++side) {
-      Eigen::Vector3d c[4] = {a[0], a[1], a[2], a[3]}, d[4] = {b[0], b[1], b[2], b[3]};
-      Eigen::Vector3d* v = side == 0 ? c : d;
-      const int i = (skip + 1) % 4, j = (skip + 2) % 4, k = (skip + 3) % 4;
-      v[k] = 0.3 * v[i] + 0.7 * v[j];
-      EXPECT_FALSE(homography_from_4_correspondences(c, d, &H)) << skip << " " << side;
-    }
-  }
+  for_each_collinear_triple(a, b, [&](const Eigen::Vector3d* c, const Eigen::Vector3d* d, int skip,
+                                      int side) {
+    EXPECT_FALSE(homography_from_4_correspondences(c, d, &H)) << skip << " " << side;
+  });
   const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
   Eigen::Vector3d with_zero[4] = {a[0], zero, a[2], a[3]};
   EXPECT_FALSE(homography_from_4_correspondences(with_zero, b, &H));
@@ -345,15 +355,10 @@ TEST(Homography4pt, AgreesWithTheGeneralMapAndRejectsCollinearTriples) {
   Eigen::Matrix3d estimate;
   ASSERT_TRUE(homography_4pt(x1, x2, &estimate));
   EXPECT_LT(homography_distance(estimate, H), 1e-12);
-  for (int skip = 0; skip < 4; ++skip) {
-    for (int side = 0; side < 2; ++side) {
-      Eigen::Vector2d c[4] = {x1[0], x1[1], x1[2], x1[3]}, d[4] = {x2[0], x2[1], x2[2], x2[3]};
-      Eigen::Vector2d* v = side == 0 ? c : d;
-      const int i = (skip + 1) % 4, j = (skip + 2) % 4, k = (skip + 3) % 4;
-      v[k] = 0.3 * v[i] + 0.7 * v[j];
-      EXPECT_FALSE(homography_4pt(c, d, &estimate)) << skip << " " << side;
-    }
-  }
+  for_each_collinear_triple(x1, x2, [&](const Eigen::Vector2d* c, const Eigen::Vector2d* d,
+                                        int skip, int side) {
+    EXPECT_FALSE(homography_4pt(c, d, &estimate)) << skip << " " << side;
+  });
   Eigen::Vector2d with_nan[4] = {x1[0], x1[1], Eigen::Vector2d(NAN, 0.0), x1[3]};
   EXPECT_FALSE(homography_4pt(with_nan, x2, &estimate));
   Eigen::Vector2d with_inf[4] = {x1[0], x1[1], x1[2], Eigen::Vector2d(INFINITY, 1.0)};
