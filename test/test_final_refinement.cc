@@ -502,3 +502,61 @@ TEST(FinalRefinement, VpPriorPullsTheRotation) {
 
 }  // namespace
 }  // namespace hybrid_vo
+
+namespace hybrid_vo {
+namespace {
+
+// vp_sigma_scale weakens one VP's segments without touching the rest: scale 1 is the default, a
+// huge scale leaves the points' rotation, and a scale that is not finite and positive fails.
+TEST(FinalRefinement, VpSigmaScaleWeakensItsVpOnly) {
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> n;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  FinalRefinementOptions options;
+  options.point_sigma_px = 2.0;
+  options.line_vp_sigma_px = 0.1;
+  FinalRefinementOptions points_only = options;
+  points_only.line_vp_sigma_px = inf;
+  points_only.vp_sigma_deg = inf;
+  for (int trial = 0; trial < 10; ++trial) {
+    Scene s = make_scene(rng, 30, 3, 60, 0.0);
+    for (PointMatch& m : s.points) {
+      m.x1 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
+      m.x2 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
+    }
+    RefinementData data;
+    data.points = s.points;
+    data.vps = s.vps;
+    data.lines = s.lines;
+    data.line_vp = s.line_vp;
+    const RelativePose start = perturb(rng, s.truth, 1.0 * kDeg, 2.0 * kDeg);
+    auto refine = [&](const FinalRefinementOptions& o) {
+      return refine_relative_pose_ceres(kCamera, kCamera, data, start, o);
+    };
+    const FinalRefinementResult plain = refine(options), points = refine(points_only);
+    data.vp_sigma_scale.assign(3, 1.0);
+    const FinalRefinementResult ones = refine(options);
+    data.vp_sigma_scale.assign(3, 1e6);
+    const FinalRefinementResult weak = refine(options);
+    ASSERT_TRUE(plain.success && points.success && ones.success && weak.success);
+    EXPECT_LT(rotation_error(ones.pose.R, plain.pose.R), 1e-12);
+    EXPECT_LT(rotation_error(weak.pose.R, points.pose.R), 1e-3 * kDeg);
+    // The exact lines pull the rotation well away from the noisy points' one.
+    EXPECT_GT(rotation_error(plain.pose.R, points.pose.R), 0.02 * kDeg);
+    EXPECT_LT(rotation_error(plain.pose.R, s.truth.R), rotation_error(points.pose.R, s.truth.R));
+    // Only VP 0 weakened: its segments no longer count, the other two still pin the rotation.
+    data.vp_sigma_scale = {1e6, 1.0, 1.0};
+    const FinalRefinementResult one_weak = refine(options);
+    ASSERT_TRUE(one_weak.success);
+    EXPECT_LT(rotation_error(one_weak.pose.R, s.truth.R),
+              0.2 * rotation_error(points.pose.R, s.truth.R));
+    for (double bad : {nan, inf, 0.0, -1.0}) {
+      data.vp_sigma_scale = {1.0, bad, 1.0};
+      EXPECT_FALSE(refine(options).success) << bad;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hybrid_vo

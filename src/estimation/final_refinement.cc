@@ -354,6 +354,8 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
                            options.point_loss_px,  options.line_vp_loss_px,  options.vp_loss_deg};
   for (double value : values)
     if (std::isnan(value)) return result;
+  for (double value : data.vp_sigma_scale)
+    if (!(value > 0.0) || !std::isfinite(value)) return result;
   // Points need a direction to start t from.
   if (!points.empty() && !(t_norm > 0.0 && std::isfinite(t_norm))) return result;
 
@@ -434,6 +436,11 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
   for (size_t k = 0; k < vps.size(); ++k) {
     if (!vp_ok[k]) continue;
     const Eigen::Vector3d d1 = vps[k].d1.normalized(), d2 = vps[k].d2.normalized();
+    const double scale = k < data.vp_sigma_scale.size() ? data.vp_sigma_scale[k] : 1.0;
+    ceres::LossFunction* line_loss_k =
+        scale == 1.0 ? line_loss
+                     : cauchy(options.line_vp_loss_px, options.line_vp_sigma_px * scale);
+    const double line_scale_k = line_scale / scale;
     // A prior needs image 2's segments to carry it to R; camera 1's are in it already or not.
     Eigen::Vector3d prior_direction;
     Eigen::Matrix<double, 3, 2> prior_basis;
@@ -458,7 +465,7 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
           const LineSegment& segment = second ? lines[i].s2 : lines[i].s1;
           if (!usable_segment(segment)) continue;
           problem.AddResidualBlock(
-              new LineFreeVpCost(second ? K2 : K1, segment, second, line_scale), line_loss, q,
+              new LineFreeVpCost(second ? K2 : K1, segment, second, line_scale_k), line_loss_k, q,
               directions[k].data());
           ++result.num_line_residuals;
         }
@@ -466,18 +473,20 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
       continue;
     }
     if (use_vps) {
-      problem.AddResidualBlock(new VpAngleCost(d1, d2, vps[k].sign_known, vp_scale), vp_loss, q);
+      problem.AddResidualBlock(
+          new VpAngleCost(d1, d2, vps[k].sign_known, vp_scale / scale),
+          scale == 1.0 ? vp_loss : cauchy(options.vp_loss_deg, options.vp_sigma_deg * scale), q);
       ++result.num_vp_residuals;
     }
     for (int i : labelled[k]) {
       if (usable_segment(lines[i].s2)) {
-        problem.AddResidualBlock(new LineVpCost(K2, lines[i].s2, d1, false, line_scale),
-                                 line_loss, q);
+        problem.AddResidualBlock(new LineVpCost(K2, lines[i].s2, d1, false, line_scale_k),
+                                 line_loss_k, q);
         ++result.num_line_residuals;
       }
       if (usable_segment(lines[i].s1)) {
-        problem.AddResidualBlock(new LineVpCost(K1, lines[i].s1, d2, true, line_scale),
-                                 line_loss, q);
+        problem.AddResidualBlock(new LineVpCost(K1, lines[i].s1, d2, true, line_scale_k),
+                                 line_loss_k, q);
         ++result.num_line_residuals;
       }
     }

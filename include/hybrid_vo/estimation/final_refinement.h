@@ -68,6 +68,9 @@ struct RefinementData {
   std::vector<VpPrior> vp_priors;      // per VP, or empty
   std::vector<LineMatch> lines;        // segments labelled with a VP, pixels
   std::vector<int> line_vp;            // per entry of `lines`: index into `vps`
+  // Per VP, or empty (all 1): multiplies the sigmas of its segments and of its VP residual. Must
+  // be finite and positive, or the refinement fails.
+  std::vector<double> vp_sigma_scale;
 };
 
 struct FinalRefinementResult {
