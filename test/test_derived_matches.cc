@@ -1,4 +1,5 @@
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -58,6 +59,31 @@ TEST(Endpoints, PairedSoThatSegmentsPointTheSameWay) {
   EXPECT_LT((ends[1].match.x2 - Eigen::Vector2d(105, -3)).norm(), 1e-12);
   lines.push_back(match({1, 1}, {1, 1}));  // zero length: no endpoints
   EXPECT_EQ(segment_endpoints(lines).size(), 2u);
+}
+
+DerivedPoint junction_at(Eigen::Vector2d x1, Eigen::Vector2d x2) {
+  DerivedPoint d;
+  d.match = {x1, x2};
+  d.source = PointSource::kJunction;
+  return d;
+}
+
+// One image position has one correspondence: a junction repeating an earlier one in either image
+// (a segment matched twice) counts once; the first is kept, distinct ones all stay.
+TEST(Junctions, DistinctDropsRepeatsInEitherImage) {
+  const std::vector<DerivedPoint> junctions = {
+      junction_at({100, 100}, {90, 105}),
+      junction_at({100.5, 100}, {120, 140}),  // image 1 repeats junction 0
+      junction_at({300, 50}, {291.5, 55}),
+      junction_at({302, 70}, {290, 55}),      // image 2 repeats junction 2
+      junction_at({103, 100}, {93, 105}),     // 3 px from junction 0 in both: distinct
+  };
+  EXPECT_EQ(distinct_junctions(junctions, 2.0), (std::vector<int>{0, 2, 4}));
+  EXPECT_EQ(distinct_junctions(junctions, 5.0), (std::vector<int>{0, 2}));
+  const std::vector<int> all = {0, 1, 2, 3, 4};
+  EXPECT_EQ(distinct_junctions(junctions, 0.0), all);
+  EXPECT_EQ(distinct_junctions(junctions, std::numeric_limits<double>::quiet_NaN()), all);
+  EXPECT_TRUE(distinct_junctions({}, 2.0).empty());
 }
 
 }  // namespace

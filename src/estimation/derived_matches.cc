@@ -68,6 +68,24 @@ std::vector<DerivedPoint> find_junctions(const std::vector<LineMatch>& lines,
   return junctions;
 }
 
+std::vector<int> distinct_junctions(const std::vector<DerivedPoint>& junctions, double radius_px) {
+  std::vector<int> kept;
+  const double radius_sq = radius_px > 0.0 ? radius_px * radius_px : -1.0;
+  for (int i = 0; i < static_cast<int>(junctions.size()); ++i) {
+    const PointMatch& m = junctions[i].match;
+    bool repeats = false;
+    for (const int k : kept) {
+      const PointMatch& n = junctions[k].match;
+      if ((n.x1 - m.x1).squaredNorm() <= radius_sq || (n.x2 - m.x2).squaredNorm() <= radius_sq) {
+        repeats = true;
+        break;
+      }
+    }
+    if (!repeats) kept.push_back(i);
+  }
+  return kept;
+}
+
 std::vector<DerivedPoint> segment_endpoints(const std::vector<LineMatch>& lines) {
   std::vector<DerivedPoint> endpoints;
   for (int i = 0; i < static_cast<int>(lines.size()); ++i) {

@@ -100,7 +100,8 @@ HybridProblem build_hybrid_problem(const PinholeCamera& camera1, const PinholeCa
     p.line_junctions[j.second].push_back(index);
   }
   if (options.junction_points)
-    for (const DerivedPoint& j : *junctions) add_to_pool(p, j, &p);
+    for (const int j : distinct_junctions(*junctions, options.junctions.duplicate_px))
+      add_to_pool(p, (*junctions)[j], &p);
   if (options.endpoint_points)
     for (const DerivedPoint& e : *endpoints) add_to_pool(p, e, &p);
 

@@ -183,6 +183,7 @@ const OptionTable<TwoViewOptions>& estimator_option_table() {
         .add("use_junction_points", FIELD(estimator.use_junction_points))
         .add("use_endpoint_points", FIELD(estimator.use_endpoint_points))
         .add("junctions_tolerance_px", FIELD(estimator.junctions.tolerance_px), Range::kNonNegative)
+        .add("junctions_duplicate_px", FIELD(estimator.junctions.duplicate_px), Range::kNonNegative)
         .add("junctions_min_angle_deg", FIELD(estimator.junctions.min_angle_deg),
              Range::kNonNegative)
         .add("final_refinement", FIELD(estimator.final_refinement))
