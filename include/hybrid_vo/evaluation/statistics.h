@@ -36,9 +36,10 @@ struct DifferenceInterval {
 // Paired bootstrap of statistic(b) - statistic(a) over groups: a[i] and b[i] are the two methods'
 // values on the same item, and items come in consecutive groups of `group_size` (e.g. one image
 // pair's RANSAC runs) that are resampled together, because the runs of one pair share its
-// difficulty and are not independent samples. Small pair sets (TUM's 16) differ by several AUC
-// points from one seed to the next, and this says whether a difference is more than that. NaN
-// (groups 0) when the sizes differ, are empty, or are not a multiple of group_size.
+// difficulty and are not independent samples. It says whether a difference holds across the
+// pairs or rests on a few of them (on TUM's 16 pairs, a few AUC points can); RANSAC's run-to-run
+// noise is not in it. NaN (groups 0) when the sizes differ, are empty, or are not a multiple of
+// group_size.
 template <class Statistic>
 DifferenceInterval paired_bootstrap_difference(const std::vector<double>& a,
                                                const std::vector<double>& b, int group_size,
