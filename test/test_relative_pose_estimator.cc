@@ -106,6 +106,26 @@ TEST(HybridEstimator, FivePointSolverKeepsItsShareOfTheDraws) {
   EXPECT_LT(adaptive.solvers[five_point].sampled, 0.4 * adaptive.iterations);
 }
 
+// An all-inlier homography sample is a right model only on a plane, so the homography's cheap
+// draws must not end the search: the 5-point draws alone reach the confidence, as in 5pc. (Had
+// they counted, about 40 five-point draws would have ended this search instead of over 200.)
+TEST(HybridEstimator, HomographyDrawsDoNotEndTheSearch) {
+  std::mt19937_64 rng(43);
+  const ManhattanScene scene = generate_manhattan_scene(rng, hard_scene());
+  RelativePoseEstimatorOptions options;
+  ASSERT_TRUE(preset_options("5pc+4pc", &options));
+  options.ransac.min_iterations = 0;
+  const RelativePoseEstimate est =
+      estimate_relative_pose(scene.camera1, scene.camera2, scene.matches, options);
+  ASSERT_EQ(est.status, EstimationStatus::kOk);
+  const double ratio = est.num_point_inliers / 400.0;
+  const double needed =
+      std::log(1.0 - options.ransac.confidence) / std::log1p(-std::pow(ratio, 5));
+  EXPECT_GT(needed, 150.0);  // the scene keeps its 50 % outliers
+  EXPECT_GE(est.solvers[static_cast<int>(SolverId::k5pt)].sampled, 0.9 * needed);
+  EXPECT_GT(est.solvers[static_cast<int>(SolverId::kHomography4pt)].sampled, 0);
+}
+
 TEST(HybridEstimator, InlierMasksMatchTheTruth) {
   std::mt19937_64 rng(31);
   const ManhattanScene scene = generate_manhattan_scene(rng, hard_scene());

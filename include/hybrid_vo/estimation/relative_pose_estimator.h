@@ -41,10 +41,11 @@ struct HybridRansacOptions {
   // samples are small), and with a few dozen 5-point draws the hybrid lost 10 AUC@10 points to
   // 5pc on TUM at gap 2 where few point inliers remain.
   double five_point_share = 0.5;
-  // Stop once every solver's draws together have missed an all-inlier sample with probability
-  // below 1 - confidence, but not before min_iterations. VP solvers reach that bound within a
-  // few draws, yet an all-inlier sample of noisy VPs can still give a wrong translation in
-  // forward motion (KITTI): 150 draws fixed every such pair on KITTI at ~1 ms (README).
+  // Stop once the draws of every solver (homography solvers only when nothing else is enabled)
+  // together have missed an all-inlier sample with probability below 1 - confidence, but not
+  // before min_iterations. VP solvers reach that bound within a few draws, yet an all-inlier
+  // sample of noisy VPs can still give a wrong translation in forward motion (KITTI): 150 draws
+  // fixed every such pair on KITTI at ~1 ms (README).
   double confidence = 0.999;
   int min_iterations = 150;
   int max_iterations = 5000;
