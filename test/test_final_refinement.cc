@@ -453,6 +453,26 @@ TEST(FinalRefinement, Timing) {
 namespace hybrid_vo {
 namespace {
 
+// 30 point matches with 2 px noise, and 3 exact VPs with 60 exact labelled segments: the lines
+// alone pin the rotation far better than the points.
+Scene noisy_points_exact_lines(std::mt19937_64& rng, std::normal_distribution<double>& n) {
+  Scene s = make_scene(rng, 30, 3, 60, 0.0);
+  for (PointMatch& m : s.points) {
+    m.x1 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
+    m.x2 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
+  }
+  return s;
+}
+
+RefinementData refinement_data(const Scene& s) {
+  RefinementData data;
+  data.points = s.points;
+  data.vps = s.vps;
+  data.lines = s.lines;
+  data.line_vp = s.line_vp;
+  return data;
+}
+
 // A VP prior (e.g. a tracked direction) pins the rotation through image 2's segments: with few
 // noisy points, an exact prior in camera 1 and exact segments in image 2, the rotation about every
 // axis the VPs span is the prior's, also when camera 1's segments are left out (includes_view1).
@@ -461,16 +481,8 @@ TEST(FinalRefinement, VpPriorPullsTheRotation) {
   std::normal_distribution<double> n;
   double with_error = 0.0, without_error = 0.0;
   for (int trial = 0; trial < 20; ++trial) {
-    Scene s = make_scene(rng, 30, 3, 60, 0.0);
-    for (PointMatch& m : s.points) {
-      m.x1 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
-      m.x2 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
-    }
-    RefinementData data;
-    data.points = s.points;
-    data.vps = s.vps;
-    data.lines = s.lines;
-    data.line_vp = s.line_vp;
+    const Scene s = noisy_points_exact_lines(rng, n);
+    RefinementData data = refinement_data(s);
     const RelativePose start = perturb(rng, s.truth, 1.0 * kDeg, 2.0 * kDeg);
     FinalRefinementOptions options;
     options.point_sigma_px = 2.0;
@@ -520,16 +532,8 @@ TEST(FinalRefinement, VpSigmaScaleWeakensItsVpOnly) {
   points_only.line_vp_sigma_px = inf;
   points_only.vp_sigma_deg = inf;
   for (int trial = 0; trial < 10; ++trial) {
-    Scene s = make_scene(rng, 30, 3, 60, 0.0);
-    for (PointMatch& m : s.points) {
-      m.x1 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
-      m.x2 += 2.0 * Eigen::Vector2d(n(rng), n(rng));
-    }
-    RefinementData data;
-    data.points = s.points;
-    data.vps = s.vps;
-    data.lines = s.lines;
-    data.line_vp = s.line_vp;
+    const Scene s = noisy_points_exact_lines(rng, n);
+    RefinementData data = refinement_data(s);
     const RelativePose start = perturb(rng, s.truth, 1.0 * kDeg, 2.0 * kDeg);
     auto refine = [&](const FinalRefinementOptions& o) {
       return refine_relative_pose_ceres(kCamera, kCamera, data, start, o);
