@@ -94,6 +94,11 @@ TEST(EvalPairsCli, MaxPointsKeepsExactlyNMatches) {
   ASSERT_EQ(o.exit_code, 0) << o.output;
   EXPECT_NE(o.output.find("max_points,selection,method,auc5"), std::string::npos) << o.output;
   EXPECT_NE(o.output.find("20,clustered,hybrid,"), std::string::npos) << o.output;
+  // The ground truth check runs on the first preset, one value per pair.
+  EXPECT_NE(o.output.find("# ground truth check: 5pc's point inliers fit the true pose to"),
+            std::string::npos)
+      << o.output;
+  EXPECT_NE(o.output.find("over 2 pairs)"), std::string::npos) << o.output;
   std::ifstream in(csv);
   std::string line;
   std::getline(in, line);

@@ -1,0 +1,29 @@
+#pragma once
+
+#include <vector>
+
+#include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/geometry/camera.h"
+#include "hybrid_vo/geometry/pose.h"
+
+namespace hybrid_vo {
+namespace evaluation {
+
+// How well a data set's ground truth can rank estimators: an estimator's point inliers should fit
+// the true pose about as well as they fit its estimate. Where they fit the truth several times
+// worse (TUM fr1: ground truth taken up to 17 ms off the images), a pose error of a few degrees
+// is the ground truth's and differences of a few AUC points between methods are not the methods'.
+
+// Sampson error of a point match in pixels under the pose's F = K2^-T [t]x R K1^-1. NaN when the
+// pose has no translation or the match is not finite.
+double sampson_error_px(const PinholeCamera& camera1, const PinholeCamera& camera2,
+                        const RelativePose& pose, const PointMatch& match);
+
+// The median of sampson_error_px over the matches whose mask entry is set (all matches when the
+// mask is empty). NaN when none, or when the mask's size differs from the matches'.
+double median_sampson_px(const PinholeCamera& camera1, const PinholeCamera& camera2,
+                         const RelativePose& pose, const std::vector<PointMatch>& matches,
+                         const std::vector<char>& mask = {});
+
+}  // namespace evaluation
+}  // namespace hybrid_vo

@@ -1,0 +1,121 @@
+// The ground-truth check of the pair evaluation (include/hybrid_vo/evaluation/ground_truth_check.h).
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "hybrid_vo/evaluation/ground_truth_check.h"
+
+namespace hybrid_vo {
+namespace evaluation {
+namespace {
+
+struct Scene {
+  PinholeCamera camera1{500.0, 520.0, 320.0, 240.0, 640, 480};
+  PinholeCamera camera2{700.0, 690.0, 300.0, 250.0, 640, 480};
+  RelativePose pose;
+  std::vector<PointMatch> matches;
+};
+
+Scene make_scene(int n, uint64_t seed) {
+  Scene s;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  s.pose.R = Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, 1.0, -0.2).normalized()).toRotationMatrix();
+  s.pose.t = Eigen::Vector3d(1.0, 0.1, 0.3).normalized();
+  while (static_cast<int>(s.matches.size()) < n) {
+    const Eigen::Vector3d X(2.0 * u(rng), 2.0 * u(rng), 5.0 + 2.0 * u(rng));
+    const Eigen::Vector3d Y = s.pose.apply(X);
+    if (Y.z() <= 0.1) continue;
+    PointMatch m;
+    m.x1 = s.camera1.denormalize(X.hnormalized());
+    m.x2 = s.camera2.denormalize(Y.hnormalized());
+    s.matches.push_back(m);
+  }
+  return s;
+}
+
+// The unit normal in image 2 of the epipolar line of x1.
+Eigen::Vector2d epipolar_normal(const Scene& s, const PointMatch& m) {
+  const Eigen::Matrix3d F =
+      s.camera2.K().inverse().transpose() * s.pose.essential() * s.camera1.K().inverse();
+  return (F * m.x1.homogeneous()).head<2>().normalized();
+}
+
+TEST(GroundTruthCheck, ExactMatchesHaveNoError) {
+  const Scene s = make_scene(50, 1);
+  for (const PointMatch& m : s.matches)
+    EXPECT_LT(sampson_error_px(s.camera1, s.camera2, s.pose, m), 1e-9);
+  EXPECT_LT(median_sampson_px(s.camera1, s.camera2, s.pose, s.matches), 1e-9);
+}
+
+TEST(GroundTruthCheck, ErrorIsInPixels) {
+  // x2 moved off its epipolar line by d pixels: the Sampson error, a first-order geometric error
+  // that may share the correction between both points, is at most d and a good part of it.
+  const Scene s = make_scene(30, 2);
+  for (const double d : {0.5, 2.0, 8.0}) {
+    for (const PointMatch& exact : s.matches) {
+      PointMatch m = exact;
+      m.x2 += d * epipolar_normal(s, exact);
+      const double e = sampson_error_px(s.camera1, s.camera2, s.pose, m);
+      EXPECT_LE(e, d * (1.0 + 1e-6));
+      EXPECT_GE(e, 0.4 * d);
+    }
+  }
+  // The same scene at twice the resolution has twice the error.
+  Scene big = s;
+  for (PinholeCamera* c : {&big.camera1, &big.camera2}) {
+    c->fx *= 2.0, c->fy *= 2.0, c->cx *= 2.0, c->cy *= 2.0;
+  }
+  for (size_t i = 0; i < s.matches.size(); ++i) {
+    PointMatch m = s.matches[i];
+    m.x2 += 1.5 * epipolar_normal(s, s.matches[i]);
+    PointMatch m2{2.0 * m.x1, 2.0 * m.x2};
+    EXPECT_NEAR(sampson_error_px(big.camera1, big.camera2, big.pose, m2),
+                2.0 * sampson_error_px(s.camera1, s.camera2, s.pose, m), 1e-9);
+  }
+}
+
+TEST(GroundTruthCheck, AWrongPoseFitsWorse) {
+  Scene s = make_scene(200, 3);
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  for (PointMatch& m : s.matches) m.x2 += Eigen::Vector2d(noise(rng), noise(rng));
+  const double right = median_sampson_px(s.camera1, s.camera2, s.pose, s.matches);
+  RelativePose wrong = s.pose;
+  wrong.R = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY()).toRotationMatrix() * wrong.R;
+  const double off = median_sampson_px(s.camera1, s.camera2, wrong, s.matches);
+  EXPECT_GT(right, 0.1);
+  EXPECT_LT(right, 0.5);
+  EXPECT_GT(off, 2.0 * right);
+}
+
+TEST(GroundTruthCheck, MaskSelectsAndBadInputIsNan) {
+  Scene s = make_scene(5, 5);
+  s.matches[0].x2 += Eigen::Vector2d(30.0, -40.0);
+  s.matches[1].x2 += Eigen::Vector2d(-30.0, 40.0);
+  s.matches[2].x2 += Eigen::Vector2d(30.0, 40.0);
+  const std::vector<char> good = {0, 0, 0, 1, 1};
+  EXPECT_GT(median_sampson_px(s.camera1, s.camera2, s.pose, s.matches), 1.0);
+  EXPECT_LT(median_sampson_px(s.camera1, s.camera2, s.pose, s.matches, good), 1e-9);
+  EXPECT_TRUE(std::isnan(median_sampson_px(s.camera1, s.camera2, s.pose, s.matches, {1, 1})));
+  EXPECT_TRUE(std::isnan(median_sampson_px(s.camera1, s.camera2, s.pose, s.matches,
+                                           {0, 0, 0, 0, 0})));
+  EXPECT_TRUE(std::isnan(median_sampson_px(s.camera1, s.camera2, s.pose, {})));
+  RelativePose rotation_only = s.pose;
+  rotation_only.t.setZero();
+  EXPECT_TRUE(std::isnan(sampson_error_px(s.camera1, s.camera2, rotation_only, s.matches[3])));
+  PointMatch bad = s.matches[3];
+  bad.x1.x() = NAN;
+  EXPECT_TRUE(std::isnan(sampson_error_px(s.camera1, s.camera2, s.pose, bad)));
+  // A non-finite match is left out of the median, not counted as zero or infinite.
+  std::vector<PointMatch> with_bad = {s.matches[3], bad, s.matches[4]};
+  EXPECT_LT(median_sampson_px(s.camera1, s.camera2, s.pose, with_bad), 1e-9);
+}
+
+}  // namespace
+}  // namespace evaluation
+}  // namespace hybrid_vo
