@@ -107,7 +107,7 @@ TEST(EvalPairsCli, MaxPointsKeepsExactlyNMatches) {
     std::vector<std::string> fields;
     std::stringstream row(line);
     for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
-    ASSERT_EQ(fields.size(), 13u) << line;
+    ASSERT_EQ(fields.size(), 14u) << line;
     const int points = std::stoi(fields[7]);
     if (fields[11] == "20") {
       EXPECT_EQ(points, 20) << line;
@@ -119,6 +119,50 @@ TEST(EvalPairsCli, MaxPointsKeepsExactlyNMatches) {
   }
   EXPECT_EQ(limited, 2 * 2 * 2 * 3);  // pairs x runs x selections x methods
   EXPECT_EQ(all, 2 * 2 * 3);
+}
+
+// --held-out: the methods see half the points, and every run is scored on the other half.
+TEST(EvalPairsCli, HeldOutScoresTheOtherHalf) {
+  const char* env = std::getenv("HYBRID_VO_DATA");
+  const std::string data =
+      (env ? std::string(env) : std::string(HYBRID_VO_SOURCE_DIR) + "/../shared/data") +
+      "/kitti_seq0x_51";
+  if (!std::ifstream(data + "/sequences/seq0x/times.txt")) GTEST_SKIP() << data << " not present";
+  const std::string csv = testing::TempDir() + "/eval_pairs_held_out.csv";
+  const std::string common = "--format kitti " + data + " --max-pairs 2 --presets 5pc --csv ";
+  const Outcome all = run("hybrid_vo_eval_pairs", common + csv);
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  auto rows = [&] {
+    std::vector<std::vector<std::string>> out;
+    std::ifstream in(csv);
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      std::vector<std::string> fields;
+      std::stringstream row(line);
+      for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+      out.push_back(fields);
+    }
+    return out;
+  };
+  const auto before = rows();
+  const Outcome o = run("hybrid_vo_eval_pairs", common + csv + " --held-out");
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("held-out cost (0 best, 1 worst), mean over pairs and runs: 5pc "),
+            std::string::npos)
+      << o.output;
+  EXPECT_NE(o.output.find(", true pose "), std::string::npos) << o.output;
+  const auto after = rows();
+  ASSERT_EQ(before.size(), 2u);
+  ASSERT_EQ(after.size(), 2u);
+  for (size_t i = 0; i < after.size(); ++i) {
+    ASSERT_EQ(after[i].size(), 14u);
+    EXPECT_EQ(before[i][13], "nan");
+    EXPECT_EQ(std::stoi(after[i][7]), std::stoi(before[i][7]) / 2);  // the estimation half
+    const double cost = std::stod(after[i][13]);
+    EXPECT_GE(cost, 0.0);
+    EXPECT_LT(cost, 0.5);  // KITTI's 5pc explains most held-out matches
+  }
 }
 
 TEST(EvalTrajectoryCli, MissingBag) {

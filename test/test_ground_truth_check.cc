@@ -116,6 +116,27 @@ TEST(GroundTruthCheck, MaskSelectsAndBadInputIsNan) {
   EXPECT_LT(median_sampson_px(s.camera1, s.camera2, s.pose, with_bad), 1e-9);
 }
 
+TEST(GroundTruthCheck, TruncatedCostCountsOutliersOnceAndInliersByTheirError) {
+  Scene s = make_scene(8, 6);
+  EXPECT_LT(truncated_sampson_cost(s.camera1, s.camera2, s.pose, s.matches, 1.0), 1e-18);
+  // Half the matches far off: each costs 1, the rest 0.
+  std::vector<PointMatch> mixed = s.matches;
+  for (int i = 0; i < 4; ++i) mixed[i].x2 += 50.0 * epipolar_normal(s, s.matches[i]);
+  EXPECT_NEAR(truncated_sampson_cost(s.camera1, s.camera2, s.pose, mixed, 1.0), 0.5, 1e-12);
+  // An inlier costs its squared error over the squared threshold.
+  std::vector<PointMatch> one = {s.matches[5]};
+  one[0].x2 += 0.8 * epipolar_normal(s, s.matches[5]);
+  const double e = sampson_error_px(s.camera1, s.camera2, s.pose, one[0]);
+  EXPECT_NEAR(truncated_sampson_cost(s.camera1, s.camera2, s.pose, one, 2.0), e * e / 4.0, 1e-12);
+  // No translation explains no parallax: every match counts as an outlier.
+  RelativePose rotation_only = s.pose;
+  rotation_only.t.setZero();
+  EXPECT_EQ(truncated_sampson_cost(s.camera1, s.camera2, rotation_only, s.matches, 1.0), 1.0);
+  EXPECT_TRUE(std::isnan(truncated_sampson_cost(s.camera1, s.camera2, s.pose, {}, 1.0)));
+  EXPECT_TRUE(std::isnan(truncated_sampson_cost(s.camera1, s.camera2, s.pose, s.matches, 0.0)));
+  EXPECT_TRUE(std::isnan(truncated_sampson_cost(s.camera1, s.camera2, s.pose, s.matches, NAN)));
+}
+
 }  // namespace
 }  // namespace evaluation
 }  // namespace hybrid_vo

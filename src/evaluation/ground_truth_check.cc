@@ -1,5 +1,6 @@
 #include "hybrid_vo/evaluation/ground_truth_check.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Dense>
@@ -32,6 +33,18 @@ double median_sampson_px(const PinholeCamera& camera1, const PinholeCamera& came
     if (std::isfinite(e)) errors.push_back(e);
   }
   return median(errors);
+}
+
+double truncated_sampson_cost(const PinholeCamera& camera1, const PinholeCamera& camera2,
+                              const RelativePose& pose, const std::vector<PointMatch>& matches,
+                              double threshold_px) {
+  if (matches.empty() || !(threshold_px > 0.0) || !std::isfinite(threshold_px)) return NAN;
+  double sum = 0.0;
+  for (const PointMatch& m : matches) {
+    const double e = sampson_error_px(camera1, camera2, pose, m) / threshold_px;
+    sum += std::isfinite(e) ? std::min(e * e, 1.0) : 1.0;
+  }
+  return sum / matches.size();
 }
 
 }  // namespace evaluation

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -36,6 +38,7 @@ struct Arguments {
   std::vector<std::string> presets = preset_names();
   bool opencv = true;
   bool vp_modes = false;
+  bool held_out = false;  // estimate on half the points, score on the other half
   std::string csv;
   int max_pairs = 0;
   uint64_t seed = 0;
@@ -68,6 +71,7 @@ void usage(const char* program) {
       << "         [--runs N] [--min-iterations N] [--point-threshold PX]\n"
       << "         [--five-point-share S] [--vp-min-inliers N] (knobs of the hybrid RANSAC)\n"
       << "         [--max-points N[,N...|all]] [--point-selection random|clustered[,...]]\n"
+      << "         [--held-out]\n"
       << "  Pairs are frames i and i+K (superglue: the pairs file, images under --images).\n"
       << "  Prints method,auc5,auc10,auc20,median_err_deg,estimator_ms,frontend_ms (AUC in %),\n"
       << "  one row per preset plus opencv_usac_magsac (findEssentialMat + recoverPose on the same\n"
@@ -83,7 +87,12 @@ void usage(const char* program) {
       << "  with a 95 % paired bootstrap interval over the pairs (each pair with all its runs),\n"
       << "  and the ground truth check: how well the first preset's point inliers fit the true\n"
       << "  pose and their estimate. Several times worse under the truth means the ground truth\n"
-      << "  shares in every pose error, and small AUC differences are not the methods'.\n";
+      << "  shares in every pose error, and small AUC differences are not the methods'.\n"
+      << "  --held-out: a score without ground truth. Every run splits the point matches at random\n"
+      << "  into halves; the methods estimate from the first (and all lines) and are scored on\n"
+      << "  the second: the mean of min(e, t)^2 / t^2 over its matches, e the Sampson error and t\n"
+      << "  the point threshold (0: all on their epipolar lines; 1: none within t; a failure\n"
+      << "  scores 1). Printed per method with the baseline difference and for the true pose.\n";
 }
 
 bool parse(int argc, char** argv, Arguments* a) {
@@ -96,6 +105,10 @@ bool parse(int argc, char** argv, Arguments* a) {
     }
     if (arg == "--vp-modes") {
       a->vp_modes = true;
+      continue;
+    }
+    if (arg == "--held-out") {
+      a->held_out = true;
       continue;
     }
     if (arg.rfind("--", 0) != 0) {
@@ -196,6 +209,7 @@ using hybrid_vo::evaluation::paired_bootstrap_difference;
 struct MethodStats {
   std::vector<double> errors, estimator_ms;
   std::vector<double> offset_x, offset_y;  // translation direction against the truth, degrees
+  std::vector<double> held_out;  // truncated_sampson_cost on the held-out half (--held-out)
 };
 
 // Where the estimated translation direction lies relative to the true one, in degrees along the
@@ -211,6 +225,22 @@ void translation_offset(const Eigen::Vector3d& estimate, const Eigen::Vector3d& 
   by = by.norm() < 1e-6 ? Eigen::Vector3d(g.cross(bx)) : Eigen::Vector3d(by.normalized());
   *x = std::atan2(t.dot(bx), t.dot(g)) * kDeg;
   *y = std::atan2(t.dot(by), t.dot(g)) * kDeg;
+}
+
+// --held-out: moves a random half of `points` (by the run's seed) into `held_out`, keeping the
+// order within each half.
+void split_held_out(uint64_t seed, std::vector<PointMatch>* points,
+                    std::vector<PointMatch>* held_out) {
+  std::vector<int> order(points->size());
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(seed ^ 0x9e3779b97f4a7c15ull));
+  std::vector<char> out(points->size(), 0);
+  for (size_t k = order.size() / 2; k < order.size(); ++k) out[order[k]] = 1;
+  std::vector<PointMatch> kept;
+  held_out->clear();
+  for (size_t i = 0; i < points->size(); ++i)
+    (out[i] ? held_out : &kept)->push_back((*points)[i]);
+  *points = std::move(kept);
 }
 
 // Feature extraction, once per image (consecutive pairs share images).
@@ -307,7 +337,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     csv << "pair,image0,image1,method,rot_err_deg,trans_err_deg,pose_err_deg,points,lines,vps,"
-           "estimator_ms,max_points,selection\n";
+           "estimator_ms,max_points,selection,held_out_cost\n";
   }
 
   FeatureCache cache(args);
@@ -328,6 +358,9 @@ int main(int argc, char** argv) {
   // Per pair: the median Sampson error (px) of the baseline's point inliers under the true pose
   // and under its estimate (evaluation/ground_truth_check.h).
   std::vector<double> gt_fit_px, estimate_fit_px;
+  // Per subset: the true pose's held-out cost, per pair and run.
+  std::map<std::string, std::vector<double>> truth_held_out;
+  const double threshold_px = args.point_threshold > 0.0 ? args.point_threshold : 1.0;
   // VP ablation: per mode, VP matches per pair, consistent matches, and the VP solvers alone.
   const std::vector<std::string> vp_modes = {"standard", "joint", "joint+refined"};
   const std::vector<SolverId> vp_solvers = {SolverId::k1vp3pt, SolverId::k2vp2pt,
@@ -364,12 +397,25 @@ int main(int argc, char** argv) {
                                                             subset.selection, seed))
             matches.points.push_back(all_matches.points[i]);
         }
+        std::vector<PointMatch> held_out;
+        if (args.held_out) {
+          split_held_out(seed, &matches.points, &held_out);
+          truth_held_out[label].push_back(evaluation::truncated_sampson_cost(
+              c0.pinhole, c1.pinhole, truth, held_out, threshold_px));
+        }
+        // `pose`: the estimate, nullptr when it failed; `offset`: record its translation offset.
         auto record = [&](const std::string& method, double rot, double trans, double ms,
-                          int vps, const RelativePose* pose) {
+                          int vps, const RelativePose* pose, bool offset) {
           MethodStats& s = stats[label][method];
           s.errors.push_back(std::max(rot, trans));
           s.estimator_ms.push_back(ms);
-          if (pose) {
+          const double cost =
+              !args.held_out ? NAN
+              : pose ? evaluation::truncated_sampson_cost(c0.pinhole, c1.pinhole, *pose, held_out,
+                                                          threshold_px)
+                     : 1.0;
+          if (args.held_out) s.held_out.push_back(cost);
+          if (pose && offset) {
             double x = 0.0, y = 0.0;
             translation_offset(pose->t, truth.t, &x, &y);
             s.offset_x.push_back(x);
@@ -379,7 +425,7 @@ int main(int argc, char** argv) {
             csv << p << ',' << pair.image_path0 << ',' << pair.image_path1 << ',' << method << ','
                 << rot << ',' << trans << ',' << std::max(rot, trans) << ','
                 << matches.points.size() << ',' << matches.lines.size() << ',' << vps << ','
-                << ms << ',' << label << '\n';
+                << ms << ',' << label << ',' << cost << '\n';
         };
         for (const std::string& preset : args.presets) {
           TwoViewOptions options;
@@ -410,7 +456,7 @@ int main(int argc, char** argv) {
           }
           record(preset, pose ? rotation_error(pose->R, truth.R) * kDeg : kFailed,
                  pose ? translation_error(pose->t, truth.t) * kDeg : kFailed, ms,
-                 static_cast<int>(result.vps.matches.size()), pose);
+                 static_cast<int>(result.vps.matches.size()), pose, true);
         }
         if (args.opencv) {
           double ms = 0.0;
@@ -419,7 +465,8 @@ int main(int argc, char** argv) {
                                      args.point_threshold > 0.0 ? args.point_threshold : 1.0, seed,
                                      &ms, &pose);
           record("opencv_usac_magsac", ok ? rotation_error(pose.R, truth.R) * kDeg : kFailed,
-                 ok ? translation_error(pose.t, truth.t) * kDeg : kFailed, ms, 0, nullptr);
+                 ok ? translation_error(pose.t, truth.t) * kDeg : kFailed, ms, 0,
+                 ok ? &pose : nullptr, false);
         }
       }
     }
@@ -486,6 +533,30 @@ int main(int argc, char** argv) {
                   "%d pairs)\n",
                   subset_columns ? (label + ": ").c_str() : "", method.c_str(), baseline.c_str(),
                   d.difference, d.low, d.high, d.groups);
+    }
+  }
+  for (const PointSubset& subset : subsets) {
+    if (!args.held_out || args.presets.empty()) break;
+    const std::string label = subset.label();
+    const std::string prefix = subset_columns ? label + ": " : "";
+    std::printf("# %sheld-out cost (0 best, 1 worst), mean over pairs and runs:", prefix.c_str());
+    auto mean = [](const std::vector<double>& v) {
+      double sum = 0.0;
+      for (double x : v) sum += x;
+      return v.empty() ? NAN : sum / v.size();
+    };
+    for (const std::string& method : methods)
+      std::printf(" %s %.4f,", method.c_str(), mean(stats[label][method].held_out));
+    std::printf(" true pose %.4f\n", mean(truth_held_out[label]));
+    const std::string& baseline = args.presets.front();
+    for (const std::string& method : methods) {
+      if (method == baseline) continue;
+      const DifferenceInterval d =
+          paired_bootstrap_difference(stats[label][baseline].held_out,
+                                      stats[label][method].held_out, args.runs, mean, 2000,
+                                      args.seed);
+      std::printf("# %s%s - %s held-out cost: %+.4f, 95 %% interval [%+.4f, %+.4f]\n",
+                  prefix.c_str(), method.c_str(), baseline.c_str(), d.difference, d.low, d.high);
     }
   }
   if (!args.presets.empty()) {

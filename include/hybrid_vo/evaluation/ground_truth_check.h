@@ -25,5 +25,14 @@ double median_sampson_px(const PinholeCamera& camera1, const PinholeCamera& came
                          const RelativePose& pose, const std::vector<PointMatch>& matches,
                          const std::vector<char>& mask = {});
 
+// A score without ground truth: how well a pose explains point matches it was not estimated
+// from. The mean over `matches` of min(e, threshold)^2 / threshold^2, e = sampson_error_px: 0
+// when every match lies on its epipolar line, 1 when none is within the threshold. A match whose
+// error is not finite (a pose without translation, a non-finite match) counts 1. NaN when there
+// are no matches or the threshold is not finite and positive.
+double truncated_sampson_cost(const PinholeCamera& camera1, const PinholeCamera& camera2,
+                              const RelativePose& pose, const std::vector<PointMatch>& matches,
+                              double threshold_px);
+
 }  // namespace evaluation
 }  // namespace hybrid_vo
