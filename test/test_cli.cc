@@ -163,6 +163,19 @@ TEST(EvalPairsCli, HeldOutScoresTheOtherHalf) {
     EXPECT_GE(cost, 0.0);
     EXPECT_LT(cost, 0.5);  // KITTI's 5pc explains most held-out matches
   }
+  // With --max-points the methods keep their N matches and are scored on all the others.
+  const Outcome few = run("hybrid_vo_eval_pairs", common + csv + " --held-out --max-points 20");
+  ASSERT_EQ(few.exit_code, 0) << few.output;
+  EXPECT_NE(few.output.find("# 20,random: held-out cost"), std::string::npos) << few.output;
+  const auto limited = rows();
+  ASSERT_EQ(limited.size(), 2u);
+  for (const auto& row : limited) {
+    ASSERT_EQ(row.size(), 14u);
+    EXPECT_EQ(std::stoi(row[7]), 20);
+    const double cost = std::stod(row[13]);
+    EXPECT_GE(cost, 0.0);
+    EXPECT_LE(cost, 1.0);
+  }
 }
 
 TEST(EvalTrajectoryCli, MissingBag) {

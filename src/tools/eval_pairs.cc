@@ -89,10 +89,12 @@ void usage(const char* program) {
       << "  pose and their estimate. Several times worse under the truth means the ground truth\n"
       << "  shares in every pose error, and small AUC differences are not the methods'.\n"
       << "  --held-out: a score without ground truth. Every run splits the point matches at random\n"
-      << "  into halves; the methods estimate from the first (and all lines) and are scored on\n"
-      << "  the second: the mean of min(e, t)^2 / t^2 over its matches, e the Sampson error and t\n"
-      << "  the point threshold (0: all on their epipolar lines; 1: none within t; a failure\n"
-      << "  scores 1). Printed per method with the baseline difference and for the true pose.\n";
+      << "  into halves (with --max-points: the N kept and the rest); the methods estimate from\n"
+      << "  the first (and all lines) and are scored on the second: the mean of min(e, t)^2 / t^2\n"
+      << "  over its matches, e the Sampson error and t the point threshold (0: all on their\n"
+      << "  epipolar lines; 1: none within t; a failure scores 1). Printed per method with the\n"
+      << "  baseline difference and for the true pose; pairs with no match left out are not\n"
+      << "  scored.\n";
 }
 
 bool parse(int argc, char** argv, Arguments* a) {
@@ -391,18 +393,26 @@ int main(int argc, char** argv) {
       for (int run = 0; run < args.runs; ++run) {
         const uint64_t seed = args.seed + p + 1000003ull * run;
         TwoViewMatches matches = all_matches;
+        // --held-out: the matches left out of the subset, or half of all of them. A pair with
+        // none left out (fewer matches than asked for) is not scored, in every run and method.
+        std::vector<PointMatch> held_out;
         if (subset.max_points >= 0) {
           matches.points.clear();
+          std::vector<char> selected(all_matches.points.size(), 0);
           for (const int i : datasets::select_point_matches(all_matches.points, subset.max_points,
-                                                            subset.selection, seed))
+                                                            subset.selection, seed)) {
             matches.points.push_back(all_matches.points[i]);
-        }
-        std::vector<PointMatch> held_out;
-        if (args.held_out) {
+            selected[i] = 1;
+          }
+          for (size_t i = 0; args.held_out && i < selected.size(); ++i)
+            if (!selected[i]) held_out.push_back(all_matches.points[i]);
+        } else if (args.held_out) {
           split_held_out(seed, &matches.points, &held_out);
+        }
+        const bool scored = args.held_out && !held_out.empty();
+        if (scored)
           truth_held_out[label].push_back(evaluation::truncated_sampson_cost(
               c0.pinhole, c1.pinhole, truth, held_out, threshold_px));
-        }
         // `pose`: the estimate, nullptr when it failed; `offset`: record its translation offset.
         auto record = [&](const std::string& method, double rot, double trans, double ms,
                           int vps, const RelativePose* pose, bool offset) {
@@ -410,11 +420,11 @@ int main(int argc, char** argv) {
           s.errors.push_back(std::max(rot, trans));
           s.estimator_ms.push_back(ms);
           const double cost =
-              !args.held_out ? NAN
-              : pose ? evaluation::truncated_sampson_cost(c0.pinhole, c1.pinhole, *pose, held_out,
-                                                          threshold_px)
-                     : 1.0;
-          if (args.held_out) s.held_out.push_back(cost);
+              !scored ? NAN
+              : pose  ? evaluation::truncated_sampson_cost(c0.pinhole, c1.pinhole, *pose, held_out,
+                                                           threshold_px)
+                      : 1.0;
+          if (scored) s.held_out.push_back(cost);
           if (pose && offset) {
             double x = 0.0, y = 0.0;
             translation_offset(pose->t, truth.t, &x, &y);
