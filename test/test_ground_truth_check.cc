@@ -1,4 +1,5 @@
-// The ground-truth check of the pair evaluation (include/hybrid_vo/evaluation/ground_truth_check.h).
+// The ground-truth check of the pair evaluation (include/hybrid_vo/evaluation/ground_truth_check.h)
+// and the core's sampson_error_px it rests on (include/hybrid_vo/geometry/epipolar_error.h).
 
 #include <cmath>
 #include <random>
@@ -24,7 +25,8 @@ Scene make_scene(int n, uint64_t seed) {
   Scene s;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  s.pose.R = Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, 1.0, -0.2).normalized()).toRotationMatrix();
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, 1.0, -0.2).normalized();
+  s.pose.R = Eigen::AngleAxisd(0.2, axis).toRotationMatrix();
   s.pose.t = Eigen::Vector3d(1.0, 0.1, 0.3).normalized();
   while (static_cast<int>(s.matches.size()) < n) {
     const Eigen::Vector3d X(2.0 * u(rng), 2.0 * u(rng), 5.0 + 2.0 * u(rng));
@@ -48,7 +50,7 @@ Eigen::Vector2d epipolar_normal(const Scene& s, const PointMatch& m) {
 TEST(GroundTruthCheck, ExactMatchesHaveNoError) {
   const Scene s = make_scene(50, 1);
   for (const PointMatch& m : s.matches)
-    EXPECT_LT(sampson_error_px(s.camera1, s.camera2, s.pose, m), 1e-9);
+    EXPECT_LT(sampson_error_px(s.camera1, s.camera2, s.pose, m.x1, m.x2), 1e-9);
   EXPECT_LT(median_sampson_px(s.camera1, s.camera2, s.pose, s.matches), 1e-9);
 }
 
@@ -60,7 +62,7 @@ TEST(GroundTruthCheck, ErrorIsInPixels) {
     for (const PointMatch& exact : s.matches) {
       PointMatch m = exact;
       m.x2 += d * epipolar_normal(s, exact);
-      const double e = sampson_error_px(s.camera1, s.camera2, s.pose, m);
+      const double e = sampson_error_px(s.camera1, s.camera2, s.pose, m.x1, m.x2);
       EXPECT_LE(e, d * (1.0 + 1e-6));
       EXPECT_GE(e, 0.4 * d);
     }
@@ -74,8 +76,8 @@ TEST(GroundTruthCheck, ErrorIsInPixels) {
     PointMatch m = s.matches[i];
     m.x2 += 1.5 * epipolar_normal(s, s.matches[i]);
     PointMatch m2{2.0 * m.x1, 2.0 * m.x2};
-    EXPECT_NEAR(sampson_error_px(big.camera1, big.camera2, big.pose, m2),
-                2.0 * sampson_error_px(s.camera1, s.camera2, s.pose, m), 1e-9);
+    EXPECT_NEAR(sampson_error_px(big.camera1, big.camera2, big.pose, m2.x1, m2.x2),
+                2.0 * sampson_error_px(s.camera1, s.camera2, s.pose, m.x1, m.x2), 1e-9);
   }
 }
 
@@ -107,10 +109,11 @@ TEST(GroundTruthCheck, MaskSelectsAndBadInputIsNan) {
   EXPECT_TRUE(std::isnan(median_sampson_px(s.camera1, s.camera2, s.pose, {})));
   RelativePose rotation_only = s.pose;
   rotation_only.t.setZero();
-  EXPECT_TRUE(std::isnan(sampson_error_px(s.camera1, s.camera2, rotation_only, s.matches[3])));
+  const PointMatch& m = s.matches[3];
+  EXPECT_TRUE(std::isnan(sampson_error_px(s.camera1, s.camera2, rotation_only, m.x1, m.x2)));
   PointMatch bad = s.matches[3];
   bad.x1.x() = NAN;
-  EXPECT_TRUE(std::isnan(sampson_error_px(s.camera1, s.camera2, s.pose, bad)));
+  EXPECT_TRUE(std::isnan(sampson_error_px(s.camera1, s.camera2, s.pose, bad.x1, bad.x2)));
   // A non-finite match is left out of the median, not counted as zero or infinite.
   std::vector<PointMatch> with_bad = {s.matches[3], bad, s.matches[4]};
   EXPECT_LT(median_sampson_px(s.camera1, s.camera2, s.pose, with_bad), 1e-9);
@@ -126,7 +129,7 @@ TEST(GroundTruthCheck, TruncatedCostCountsOutliersOnceAndInliersByTheirError) {
   // An inlier costs its squared error over the squared threshold.
   std::vector<PointMatch> one = {s.matches[5]};
   one[0].x2 += 0.8 * epipolar_normal(s, s.matches[5]);
-  const double e = sampson_error_px(s.camera1, s.camera2, s.pose, one[0]);
+  const double e = sampson_error_px(s.camera1, s.camera2, s.pose, one[0].x1, one[0].x2);
   EXPECT_NEAR(truncated_sampson_cost(s.camera1, s.camera2, s.pose, one, 2.0), e * e / 4.0, 1e-12);
   // No translation explains no parallax: every match counts as an outlier.
   RelativePose rotation_only = s.pose;

@@ -9,7 +9,10 @@ Two-View Relative Pose Estimation", Hruby et al., 3DV 2024):
 - detect_vanishing_points, in one image or jointly in two;
 - match_image_pair, the OpenCV front end on NumPy images (submodule hybrid_vo.frontend,
   loaded on first use);
-- hybrid_vo.synthetic, the C++ generators of minimal problems and Manhattan scenes.
+- hybrid_vo.synthetic, the C++ generators of minimal problems and Manhattan scenes;
+- pose_error_deg against a true pose, and sampson_errors_px: how well a pose explains point
+  matches (with the truth: how good the ground truth is; on held-out matches: a score of an
+  estimate without ground truth).
 
 Conventions: X2 = R X1 + t with unit t; solvers take normalised coordinates (K^-1 x), the
 estimator pixels; segments are their endpoints (x1, y1, x2, y2); VPs are directions K^-1 v.
@@ -38,6 +41,7 @@ from ._core import (  # noqa: F401  (re-exported)
     relpose_homography_3pt_1line,
     relpose_homography_4line,
     relpose_homography_4pt,
+    sampson_errors_px,
     solve_minimal,
     solvers,
     synthetic,
@@ -107,5 +111,5 @@ __all__ = [
     "relpose_1vp_orthline_2pt", "relpose_2pt_3line", "relpose_2vp_2pt", "relpose_5pt",
     "relpose_homography_1pt_3line", "relpose_homography_2pt_2line",
     "relpose_homography_3pt_1line", "relpose_homography_4line", "relpose_homography_4pt",
-    "solve_minimal", "solvers", "synthetic", "vp_detection_options",
+    "sampson_errors_px", "solve_minimal", "solvers", "synthetic", "vp_detection_options",
 ]

@@ -1,6 +1,7 @@
 // The minimal solvers (paper Fig. 2), one Python function per C++ function, plus the dispatcher
 // solve_minimal and the solver table.
 #include "bindings.h"
+#include "hybrid_vo/geometry/epipolar_error.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
 #include "hybrid_vo/solvers/relpose_1vp_2line_1pt.h"
@@ -23,6 +24,17 @@ py::list poses_to_list(const RelativePoses& poses) {
   py::list out;
   for (const RelativePose& pose : poses) out.append(pose_to_tuple(pose));
   return out;
+}
+
+Eigen::Matrix3d rotation_argument(py::handle value, const char* name) {
+  const MatrixArgument a(value, name, 3, 3);
+  Eigen::Matrix3d out;
+  for (int i = 0; i < 3; ++i) out.row(i) = a.vector3(i).transpose();
+  return out;
+}
+
+Eigen::Vector3d translation_argument(py::handle value, const char* name) {
+  return MatrixArgument(value, name, 3, 1).vector3(0);
 }
 
 Eigen::Vector3d vp_argument(py::handle value, const std::string& name) {
@@ -289,19 +301,11 @@ void bind_solvers(py::module_& m) {
   m.def(
       "pose_error_deg",
       [](py::handle R, py::handle t, py::handle R_true, py::handle t_true) {
-        auto rotation = [](py::handle value, const char* name) {
-          const MatrixArgument a(value, name, 3, 3);
-          Eigen::Matrix3d out;
-          for (int i = 0; i < 3; ++i) out.row(i) = a.vector3(i).transpose();
-          return out;
-        };
-        auto translation = [](py::handle value, const char* name) {
-          return MatrixArgument(value, name, 3, 1).vector3(0);
-        };
         const double deg = 180.0 / M_PI;
         return py::make_tuple(
-            rotation_error(rotation(R, "R"), rotation(R_true, "R_true")) * deg,
-            translation_error(translation(t, "t"), translation(t_true, "t_true")) * deg);
+            rotation_error(rotation_argument(R, "R"), rotation_argument(R_true, "R_true")) * deg,
+            translation_error(translation_argument(t, "t"), translation_argument(t_true, "t_true")) *
+                deg);
       },
       "R"_a, "t"_a, "R_true"_a, "t_true"_a,
       "pose_error_deg(R, t, R_true, t_true)\n--\n\n"
@@ -309,6 +313,32 @@ void bind_solvers(py::module_& m) {
       "angle of\nR^T R_true and the angle between the translation directions (90 when exactly "
       "one t is zero).\nThe pose error of the AUC@5/10/20 tables is their maximum. R: 3 x 3, t: "
       "3-vector (any scale).");
+
+  m.def(
+      "sampson_errors_px",
+      [](py::handle camera1, py::handle camera2, py::handle R, py::handle t, py::handle points1,
+         py::handle points2) {
+        const PinholeCamera c1 = camera_argument(camera1, "camera1");
+        const PinholeCamera c2 = camera_argument(camera2, "camera2");
+        const RelativePose pose(rotation_argument(R, "R"), translation_argument(t, "t"));
+        const MatrixArgument p1(points1, "points1", 2), p2(points2, "points2", 2);
+        if (p1.rows() != p2.rows())
+          throw_value_error("points2", std::to_string(p2.rows()) + " rows, but points1 has " +
+                                           std::to_string(p1.rows()));
+        py::array_t<double> out(p1.rows());
+        auto e = out.mutable_unchecked<1>();
+        for (py::ssize_t i = 0; i < p1.rows(); ++i)
+          e(i) = sampson_error_px(c1, c2, pose, p1.point(i), p2.point(i));
+        return out;
+      },
+      "camera1"_a, "camera2"_a, "R"_a, "t"_a, "points1"_a, "points2"_a,
+      "sampson_errors_px(camera1, camera2, R, t, points1, points2)\n--\n\n"
+      "Sampson error in pixels of every point match (row i of points1 with row i of points2, "
+      "N x 2\nundistorted pixels) under the pose X2 = R X1 + t: the point residual that the "
+      "estimator scores\nagainst its 1 px threshold. An (N,) array; all NaN when t is zero. "
+      "With the true pose it\nmeasures the ground truth (how far a data set's truth can rank "
+      "estimators); on matches an\nestimate did not see it scores the estimate without ground "
+      "truth (hybrid_vo_eval_pairs\n--held-out).");
 }
 
 }  // namespace python

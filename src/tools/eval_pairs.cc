@@ -88,13 +88,13 @@ void usage(const char* program) {
       << "  and the ground truth check: how well the first preset's point inliers fit the true\n"
       << "  pose and their estimate. Several times worse under the truth means the ground truth\n"
       << "  shares in every pose error, and small AUC differences are not the methods'.\n"
-      << "  --held-out: a score without ground truth. Every run splits the point matches at random\n"
-      << "  into halves (with --max-points: the N kept and the rest); the methods estimate from\n"
-      << "  the first (and all lines) and are scored on the second: the mean of min(e, t)^2 / t^2\n"
-      << "  over its matches, e the Sampson error and t the point threshold (0: all on their\n"
-      << "  epipolar lines; 1: none within t; a failure scores 1). Printed per method with the\n"
-      << "  baseline difference and for the true pose; pairs with no match left out are not\n"
-      << "  scored.\n";
+      << "  --held-out: a score without ground truth. Every run splits the point matches at\n"
+      << "  random into halves (with --max-points: the N kept and the rest); the methods\n"
+      << "  estimate from the first (and all lines) and are scored on the second: the mean of\n"
+      << "  min(e, t)^2 / t^2 over its matches, e the Sampson error and t the point threshold\n"
+      << "  (0: all on their epipolar lines; 1: none within t; a failure scores 1). Printed per\n"
+      << "  method with the baseline difference and for the true pose; pairs with no match left\n"
+      << "  out are not scored.\n";
 }
 
 bool parse(int argc, char** argv, Arguments* a) {

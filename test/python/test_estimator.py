@@ -151,3 +151,40 @@ def test_zero_length_segments_are_counted_not_used():
     inputs["segments1"] = segments1
     est = hybrid_vo.estimate_relative_pose(**inputs)
     assert est.ok and est.rejected == {"points": 0, "lines": 1, "vps": 0}
+
+
+def test_sampson_errors_rank_the_truth_and_score_held_out_matches():
+    scene = hybrid_vo.synthetic.manhattan_scenes(1, seed=5, num_points=400, noise_px=0.5,
+                                                 point_outlier_ratio=0.2)[0]
+    inputs = scene["inputs"]
+    inlier = scene["point_inlier"]
+    args = (inputs["camera1"], inputs["camera2"])
+    truth = hybrid_vo.sampson_errors_px(*args, scene["R"], scene["t"], inputs["points1"],
+                                        inputs["points2"])
+    assert truth.shape == (len(inlier),) and truth.dtype == np.float64
+    # Inliers carry 0.5 px of noise; random outliers are far off their epipolar lines.
+    assert 0.1 < np.median(truth[inlier]) < 0.6
+    assert np.median(truth[~inlier]) > 5.0
+    # Estimated on half the matches, the pose explains the other half about as well as the truth.
+    half = np.arange(len(inlier)) % 2 == 0
+    est = hybrid_vo.estimate_relative_pose(
+        *args, np.ascontiguousarray(inputs["points1"][half]),
+        np.ascontiguousarray(inputs["points2"][half]), seed=2)
+    held_out = hybrid_vo.sampson_errors_px(*args, est.R, est.t, inputs["points1"][~half],
+                                           inputs["points2"][~half])
+    assert np.median(held_out[inlier[~half]]) < 1.2 * np.median(truth[inlier & ~half])
+    # A rotation 2 degrees off does not.
+    c, s = np.cos(np.radians(2.0)), np.sin(np.radians(2.0))
+    off = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]) @ scene["R"]
+    wrong = hybrid_vo.sampson_errors_px(*args, off, scene["t"], inputs["points1"],
+                                        inputs["points2"])
+    assert np.median(wrong[inlier]) > 5.0 * np.median(truth[inlier])
+    # No translation: no epipolar geometry.
+    assert np.isnan(hybrid_vo.sampson_errors_px(*args, scene["R"], np.zeros(3),
+                                                inputs["points1"], inputs["points2"])).all()
+    with pytest.raises(ValueError, match="points2"):
+        hybrid_vo.sampson_errors_px(*args, scene["R"], scene["t"], inputs["points1"],
+                                    inputs["points2"][:-1])
+    with pytest.raises(ValueError, match="R"):
+        hybrid_vo.sampson_errors_px(*args, np.eye(2), scene["t"], inputs["points1"],
+                                    inputs["points2"])

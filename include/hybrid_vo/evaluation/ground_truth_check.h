@@ -4,6 +4,7 @@
 
 #include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/geometry/camera.h"
+#include "hybrid_vo/geometry/epipolar_error.h"
 #include "hybrid_vo/geometry/pose.h"
 
 namespace hybrid_vo {
@@ -14,13 +15,9 @@ namespace evaluation {
 // worse (TUM fr1: ground truth taken up to 17 ms off the images), a pose error of a few degrees
 // is the ground truth's and differences of a few AUC points between methods are not the methods'.
 
-// Sampson error of a point match in pixels under the pose's F = K2^-T [t]x R K1^-1. NaN when the
-// pose has no translation or the match is not finite.
-double sampson_error_px(const PinholeCamera& camera1, const PinholeCamera& camera2,
-                        const RelativePose& pose, const PointMatch& match);
-
-// The median of sampson_error_px over the matches whose mask entry is set (all matches when the
-// mask is empty). NaN when none, or when the mask's size differs from the matches'.
+// The median of sampson_error_px (geometry/epipolar_error.h) over the matches whose mask entry
+// is set (all matches when the mask is empty). NaN when none, or when the mask's size differs
+// from the matches'.
 double median_sampson_px(const PinholeCamera& camera1, const PinholeCamera& camera2,
                          const RelativePose& pose, const std::vector<PointMatch>& matches,
                          const std::vector<char>& mask = {});
