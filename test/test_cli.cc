@@ -77,13 +77,32 @@ TEST(EvalPairsCli, BadOptionValues) {
                "--point-selection");
 }
 
+// The shared KITTI frames: ../shared/data from the checkout, as the data sets' README says, or
+// $HYBRID_VO_DATA.
+std::string shared_kitti() {
+  const char* env = std::getenv("HYBRID_VO_DATA");
+  return (env ? std::string(env) : std::string(HYBRID_VO_SOURCE_DIR) + "/../shared/data") +
+         "/kitti_seq0x_51";
+}
+
+// The rows of hybrid_vo_eval_pairs' CSV after the header, split at commas.
+std::vector<std::vector<std::string>> csv_rows(const std::string& path) {
+  std::vector<std::vector<std::string>> out;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+    out.push_back(fields);
+  }
+  return out;
+}
+
 // On the shared KITTI frames when present: every run of every method sees exactly N points.
 TEST(EvalPairsCli, MaxPointsKeepsExactlyNMatches) {
-  // ../shared/data from the checkout, as the data sets' README says, or $HYBRID_VO_DATA.
-  const char* env = std::getenv("HYBRID_VO_DATA");
-  const std::string data =
-      (env ? std::string(env) : std::string(HYBRID_VO_SOURCE_DIR) + "/../shared/data") +
-      "/kitti_seq0x_51";
+  const std::string data = shared_kitti();
   if (!std::ifstream(data + "/sequences/seq0x/times.txt")) GTEST_SKIP() << data << " not present";
   const std::string csv = testing::TempDir() + "/eval_pairs_max_points.csv";
   const Outcome o = run("hybrid_vo_eval_pairs", "--format kitti " + data +
@@ -99,21 +118,15 @@ TEST(EvalPairsCli, MaxPointsKeepsExactlyNMatches) {
             std::string::npos)
       << o.output;
   EXPECT_NE(o.output.find("over 2 pairs)"), std::string::npos) << o.output;
-  std::ifstream in(csv);
-  std::string line;
-  std::getline(in, line);
   int limited = 0, all = 0;
-  while (std::getline(in, line)) {
-    std::vector<std::string> fields;
-    std::stringstream row(line);
-    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
-    ASSERT_EQ(fields.size(), 14u) << line;
+  for (const std::vector<std::string>& fields : csv_rows(csv)) {
+    ASSERT_EQ(fields.size(), 14u) << fields[0];
     const int points = std::stoi(fields[7]);
     if (fields[11] == "20") {
-      EXPECT_EQ(points, 20) << line;
+      EXPECT_EQ(points, 20) << fields[0];
       ++limited;
     } else {
-      EXPECT_GT(points, 100) << line;
+      EXPECT_GT(points, 100) << fields[0];
       ++all;
     }
   }
@@ -123,36 +136,20 @@ TEST(EvalPairsCli, MaxPointsKeepsExactlyNMatches) {
 
 // --held-out: the methods see half the points, and every run is scored on the other half.
 TEST(EvalPairsCli, HeldOutScoresTheOtherHalf) {
-  const char* env = std::getenv("HYBRID_VO_DATA");
-  const std::string data =
-      (env ? std::string(env) : std::string(HYBRID_VO_SOURCE_DIR) + "/../shared/data") +
-      "/kitti_seq0x_51";
+  const std::string data = shared_kitti();
   if (!std::ifstream(data + "/sequences/seq0x/times.txt")) GTEST_SKIP() << data << " not present";
   const std::string csv = testing::TempDir() + "/eval_pairs_held_out.csv";
   const std::string common = "--format kitti " + data + " --max-pairs 2 --presets 5pc --csv ";
   const Outcome all = run("hybrid_vo_eval_pairs", common + csv);
   ASSERT_EQ(all.exit_code, 0) << all.output;
-  auto rows = [&] {
-    std::vector<std::vector<std::string>> out;
-    std::ifstream in(csv);
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) {
-      std::vector<std::string> fields;
-      std::stringstream row(line);
-      for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
-      out.push_back(fields);
-    }
-    return out;
-  };
-  const auto before = rows();
+  const auto before = csv_rows(csv);
   const Outcome o = run("hybrid_vo_eval_pairs", common + csv + " --held-out");
   ASSERT_EQ(o.exit_code, 0) << o.output;
   EXPECT_NE(o.output.find("held-out cost (0 best, 1 worst), mean over pairs and runs: 5pc "),
             std::string::npos)
       << o.output;
   EXPECT_NE(o.output.find(", true pose "), std::string::npos) << o.output;
-  const auto after = rows();
+  const auto after = csv_rows(csv);
   ASSERT_EQ(before.size(), 2u);
   ASSERT_EQ(after.size(), 2u);
   for (size_t i = 0; i < after.size(); ++i) {
@@ -167,7 +164,7 @@ TEST(EvalPairsCli, HeldOutScoresTheOtherHalf) {
   const Outcome few = run("hybrid_vo_eval_pairs", common + csv + " --held-out --max-points 20");
   ASSERT_EQ(few.exit_code, 0) << few.output;
   EXPECT_NE(few.output.find("# 20,random: held-out cost"), std::string::npos) << few.output;
-  const auto limited = rows();
+  const auto limited = csv_rows(csv);
   ASSERT_EQ(limited.size(), 2u);
   for (const auto& row : limited) {
     ASSERT_EQ(row.size(), 14u);
