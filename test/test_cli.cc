@@ -1,6 +1,7 @@
 // The command-line tools' error paths: bad arguments and unreadable inputs give a non-zero exit
 // and a message that names the problem, never a crash or a made-up pose.
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -173,6 +174,44 @@ TEST(EvalPairsCli, HeldOutScoresTheOtherHalf) {
     EXPECT_GE(cost, 0.0);
     EXPECT_LE(cost, 1.0);
   }
+}
+
+// Reads "<label> - direct: median X deg" from bench_frontend's --direct-gap lines; NaN if absent.
+double direct_median(const std::string& output, const std::string& label) {
+  const std::string key = label + " - direct: median ";
+  const size_t at = output.find(key);
+  return at == std::string::npos ? std::nan("") : std::atof(output.c_str() + at + key.size());
+}
+
+// On the shared KITTI frames when present: --trajectory writes every frame's pose, and
+// --direct-gap compares the odometry's and the truth's rotations over G frames with direct
+// two-view estimates. KITTI's truth is known to be 3-5 times further from them than the
+// odometry (README, "Through the node").
+TEST(BenchFrontendCli, TrajectoryAndDirectCheck) {
+  const std::string data = shared_kitti();
+  if (!std::ifstream(data + "/sequences/seq0x/times.txt")) GTEST_SKIP() << data << " not present";
+  const std::string path = testing::TempDir() + "/bench_frontend_trajectory.txt";
+  const Outcome o = run("hybrid_vo_bench_frontend", data + "/sequences/seq0x --frames 12 "
+                                                        "--preset 5pc --direct-gap 2 "
+                                                        "--trajectory " + path);
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("rotation over 2 frames against a direct two-view estimate (10 of 10 "
+                          "pairs estimated)"),
+            std::string::npos)
+      << o.output;
+  const double odometry = direct_median(o.output, "odometry");
+  const double truth = direct_median(o.output, "truth");
+  EXPECT_GT(odometry, 0.0) << o.output;
+  EXPECT_GT(truth, 3.0 * odometry) << o.output;
+  std::ifstream in(path);
+  std::string line;
+  int poses = 0;
+  while (std::getline(in, line))
+    if (!line.empty() && line[0] != '#') ++poses;
+  EXPECT_EQ(poses, 12);
+  expect_error(run("hybrid_vo_bench_frontend", data + "/sequences/seq0x --frames 2 --trajectory "
+                                                      "/no/such/folder/t.txt"),
+               "/no/such/folder/t.txt: cannot write");
 }
 
 TEST(EvalTrajectoryCli, MissingBag) {

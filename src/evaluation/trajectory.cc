@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -147,6 +148,15 @@ TrajectoryErrors compare_trajectories(const Trajectory& estimate, const Trajecto
   return e;
 }
 
+Eigen::Matrix3d relative_rotation(const StampedPose& from, const StampedPose& to) {
+  return to.R.transpose() * from.R;
+}
+
+Eigen::Vector3d rotation_difference_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  const Eigen::AngleAxisd aa(Eigen::Matrix3d(a * b.transpose()));
+  return aa.angle() * aa.axis() * 180.0 / M_PI;
+}
+
 bool read_tum_trajectory(const std::string& path, Trajectory* trajectory, std::string* error) {
   std::ifstream in(path);
   if (!in) {
@@ -188,6 +198,34 @@ bool read_tum_trajectory(const std::string& path, Trajectory* trajectory, std::s
             [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
   if (trajectory->empty()) {
     *error = path + ": no poses";
+    return false;
+  }
+  return true;
+}
+
+bool write_tum_trajectory(const std::string& path, const Trajectory& trajectory,
+                          std::string* error) {
+  std::ofstream out(path);
+  if (!out) {
+    *error = path + ": cannot write";
+    return false;
+  }
+  out << "# timestamp tx ty tz qx qy qz qw (camera to world)\n";
+  char line[256];
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    const StampedPose& p = trajectory[i];
+    if (!std::isfinite(p.stamp) || !p.R.allFinite() || !p.c.allFinite()) {
+      *error = path + ": pose " + std::to_string(i) + " is not finite";
+      return false;
+    }
+    const Eigen::Quaterniond q(p.R);
+    std::snprintf(line, sizeof(line), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", p.stamp,
+                  p.c.x(), p.c.y(), p.c.z(), q.x(), q.y(), q.z(), q.w());
+    out << line;
+  }
+  out.flush();
+  if (!out) {
+    *error = path + ": write failed";
     return false;
   }
   return true;

@@ -22,8 +22,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "hybrid_vo/datasets/kitti.h"
+#include "hybrid_vo/estimation/relative_pose_estimator.h"
 #include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/evaluation/trajectory.h"
+#include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/pose_error.h"
 
@@ -35,12 +37,71 @@ using evaluation::median;
 void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
-               " [--stereo]\n"
+               " [--stereo] [--trajectory FILE] [--direct-gap G]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction. Default preset\n"
-               "  hybrid+junc.\n";
+               "  hybrid+junc. --trajectory: every frame's camera pose in the odometry frame, TUM\n"
+               "  format (timestamp tx ty tz qx qy qz qw; stamps from times.txt + 1 s, as\n"
+               "  kitti_to_bag writes them).\n"
+               "  --direct-gap G: a check without ground truth. Every frame i is also matched\n"
+               "  directly with frame i+G (SIFT, the pair tools' front end) and `5pc` estimates\n"
+               "  their rotation; the odometry's chained rotation over the same G frames, and the\n"
+               "  truth's, are compared with it. Where the truth is much further from these\n"
+               "  direct estimates than the odometry is, the drift against it is the truth's.\n";
+}
+
+// The median of each coordinate.
+Eigen::Vector3d median_vector(const std::vector<Eigen::Vector3d>& vectors) {
+  Eigen::Vector3d m;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> values;
+    for (const Eigen::Vector3d& v : vectors) values.push_back(v[k]);
+    m[k] = median(values);
+  }
+  return m;
+}
+
+void print_difference(const char* name, const std::vector<Eigen::Vector3d>& differences) {
+  std::vector<double> sizes;
+  for (const Eigen::Vector3d& d : differences) sizes.push_back(d.norm());
+  const Eigen::Vector3d m = median_vector(differences);
+  std::printf("  %s - direct: median %.4f deg, median per axis %.4f %.4f %.4f (camera)\n", name,
+              median(sizes), m.x(), m.y(), m.z());
+}
+
+// --direct-gap: chained rotations over `gap` frames against one two-view estimate across them
+// (independent of KLT, of the chain and of the ground truth), and the truth against the same.
+void print_direct_check(const std::vector<cv::Mat>& images, const CameraModel& camera,
+                        const evaluation::Trajectory& odometry,
+                        const evaluation::Trajectory& truth, int gap, uint64_t seed) {
+  FrontendOptions frontend;
+  frontend.use_lines = false;
+  RelativePoseEstimatorOptions options;
+  preset_options("5pc", &options);
+  options.ransac.seed = seed;
+  std::vector<ImageFeatures> features;
+  for (const cv::Mat& image : images) features.push_back(extract_features(image, frontend));
+  std::vector<Eigen::Vector3d> chained, true_minus_direct;
+  for (size_t i = 0; i + gap < images.size(); ++i) {
+    const TwoViewMatches matches =
+        match_features(features[i], features[i + gap], camera, camera, frontend);
+    const RelativePoseEstimate direct =
+        estimate_relative_pose(camera.pinhole, camera.pinhole, matches, options);
+    if (direct.status != EstimationStatus::kOk) continue;
+    chained.push_back(evaluation::rotation_difference_deg(
+        evaluation::relative_rotation(odometry[i], odometry[i + gap]), direct.pose.R));
+    if (i + gap < truth.size())
+      true_minus_direct.push_back(evaluation::rotation_difference_deg(
+          evaluation::relative_rotation(truth[i], truth[i + gap]), direct.pose.R));
+  }
+  std::printf("rotation over %d frames against a direct two-view estimate (%zu of %zu pairs "
+              "estimated):\n",
+              gap, chained.size(), images.size() > static_cast<size_t>(gap) ? images.size() - gap : 0);
+  if (chained.empty()) return;
+  print_difference("odometry", chained);
+  if (!true_minus_direct.empty()) print_difference("truth", true_minus_direct);
 }
 
 double cpu_ms() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
@@ -58,6 +119,8 @@ int run(int argc, char** argv) {
   int max_features = 1500;
   bool verbose = false;
   int vp_min_inliers = 6;
+  std::string trajectory_path;
+  int direct_gap = 0;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -73,6 +136,8 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--verbose") verbose = true;
+    else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
+    else if (a == "--direct-gap" && i + 1 < argc) direct_gap = std::atoi(argv[++i]);
     else if (a == "--seed" && i + 1 < argc)
       o.estimator.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
@@ -140,7 +205,7 @@ int run(int argc, char** argv) {
     datasets::read_kitti_poses(root + "/../poses/" + name + ".txt", &gt, &ignored);
   }
   std::vector<double> pose_errors, rotation_nees;
-  evaluation::Trajectory estimate, truth;
+  evaluation::Trajectory estimate, truth, odometry;
   // Stamps from times.txt (1 s added, as kitti_to_bag does), so that a sequence with frames left
   // out has the gaps a live camera's dropped frames leave; 10 Hz without the file.
   std::vector<double> stamps;
@@ -174,6 +239,13 @@ int run(int argc, char** argv) {
     if (stereo) input.right_image = right_images[i];
     const double cpu_start = cpu_ms();
     const VisualOdometryResult r = vo.process(input);
+    {
+      evaluation::StampedPose p;
+      p.stamp = input.stamp;
+      p.R = r.R_wc;
+      p.c = r.centre;
+      odometry.push_back(p);
+    }
     if (static_cast<int>(gt.size()) > i) {
       evaluation::StampedPose e, g;
       e.stamp = g.stamp = input.stamp;
@@ -306,6 +378,14 @@ int run(int argc, char** argv) {
     if (!rotation_nees.empty())
       std::printf("rotation NEES (3 if the covariance is right): median %.1f over %zu pairs\n",
                   median(rotation_nees), rotation_nees.size());
+  }
+  if (direct_gap > 0)
+    print_direct_check(images, input.camera, odometry, truth, direct_gap,
+                       o.estimator.estimator.ransac.seed);
+  if (!trajectory_path.empty() &&
+      !evaluation::write_tum_trajectory(trajectory_path, odometry, &error)) {
+    std::cerr << error << "\n";
+    return 1;
   }
   if (o.track_lines)
     std::printf("line inlier ratio (pooled): searched %.3f of %.0f, LBD fallback %.3f of %.0f\n",

@@ -52,8 +52,21 @@ TrajectoryErrors compare_trajectories(const Trajectory& estimate, const Trajecto
                                       std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>*
                                           aligned = nullptr);
 
+// The rotation of camera `to` relative to camera `from` of a camera-to-world trajectory, as a
+// relative pose has it: X_to = R X_from.
+Eigen::Matrix3d relative_rotation(const StampedPose& from, const StampedPose& to);
+
+// The rotation vector (degrees) of a * b^T: how far rotation a is from rotation b, about which
+// axis (in the frame both map into).
+Eigen::Vector3d rotation_difference_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
+
 // TUM format: "timestamp tx ty tz qx qy qz qw" per line, '#' comments. False with file:line.
 bool read_tum_trajectory(const std::string& path, Trajectory* trajectory, std::string* error);
+// Writes the same format (stamps to the microsecond, positions and quaternions to 1e-9), which
+// read_tum_trajectory, evo and the TUM tools read. False with the reason when the file cannot be
+// written or a pose is not finite.
+bool write_tum_trajectory(const std::string& path, const Trajectory& trajectory,
+                          std::string* error);
 
 }  // namespace evaluation
 }  // namespace hybrid_vo
