@@ -214,6 +214,12 @@ TEST(BenchFrontendCli, TrajectoryAndDirectCheck) {
                "/no/such/folder/t.txt: cannot write");
 }
 
+TEST(BenchFrontendCli, BadDirectGap) {
+  for (const char* gap : {"0", "-3", "four"})
+    expect_error(run("hybrid_vo_bench_frontend", std::string("/no/sequence --direct-gap ") + gap),
+                 "--direct-gap: expected a number of frames >= 1");
+}
+
 TEST(EvalTrajectoryCli, MissingBag) {
   expect_error(run("hybrid_vo_eval_trajectory", "--bag /no/run.bag --gt /no/gt.bag"),
                "/no/run.bag");

@@ -96,9 +96,10 @@ void print_direct_check(const std::vector<cv::Mat>& images, const CameraModel& c
       true_minus_direct.push_back(evaluation::rotation_difference_deg(
           evaluation::relative_rotation(truth[i], truth[i + gap]), direct.pose.R));
   }
+  const size_t pairs = images.size() > static_cast<size_t>(gap) ? images.size() - gap : 0;
   std::printf("rotation over %d frames against a direct two-view estimate (%zu of %zu pairs "
               "estimated):\n",
-              gap, chained.size(), images.size() > static_cast<size_t>(gap) ? images.size() - gap : 0);
+              gap, chained.size(), pairs);
   if (chained.empty()) return;
   print_difference("odometry", chained);
   if (!true_minus_direct.empty()) print_difference("truth", true_minus_direct);
@@ -137,7 +138,13 @@ int run(int argc, char** argv) {
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
-    else if (a == "--direct-gap" && i + 1 < argc) direct_gap = std::atoi(argv[++i]);
+    else if (a == "--direct-gap" && i + 1 < argc) {
+      direct_gap = std::atoi(argv[++i]);
+      if (direct_gap < 1) {
+        std::cerr << "--direct-gap: expected a number of frames >= 1, got '" << argv[i] << "'\n";
+        return 2;
+      }
+    }
     else if (a == "--seed" && i + 1 < argc)
       o.estimator.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
@@ -247,13 +254,11 @@ int run(int argc, char** argv) {
       odometry.push_back(p);
     }
     if (static_cast<int>(gt.size()) > i) {
-      evaluation::StampedPose e, g;
-      e.stamp = g.stamp = input.stamp;
-      e.R = r.R_wc;
-      e.c = r.centre;
+      evaluation::StampedPose g;
+      g.stamp = input.stamp;
       g.R = gt[i].R_wc;
       g.c = gt[i].c_w;
-      estimate.push_back(e);
+      estimate.push_back(odometry.back());
       truth.push_back(g);
       const int reference = frame_of(r.reference_stamp);
       if (i > 0 && reference >= 0 && reference < i) {
