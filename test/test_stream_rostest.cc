@@ -302,7 +302,9 @@ TEST(Overload, DropsTheOldestCountsEveryFrameAndBoundsLatency) {
   };
 
   // The sustainable rate: in lock-step (each frame published once the previous one was
-  // answered), the rate at which 19 of 20 frames are done before the next one comes.
+  // answered), the rate the median cycle allows. Not a slower quantile: a load spike on the
+  // machine during this measurement would then halve the rate, and the node would keep up with
+  // twice it once the spike is over (a CI run beside benchmarks did: 509 passed, this failed).
   std::vector<double> cycles_ms;
   for (int i = 0; i < 25; ++i) {
     const Clock::time_point t0 = Clock::now();
@@ -310,7 +312,7 @@ TEST(Overload, DropsTheOldestCountsEveryFrameAndBoundsLatency) {
     if (i >= 5) cycles_ms.push_back(ms(Clock::now() - t0));  // after the first frames' setup
   }
   std::sort(cycles_ms.begin(), cycles_ms.end());
-  const double sustainable_hz = 1000.0 / cycles_ms[cycles_ms.size() * 95 / 100];
+  const double sustainable_hz = 1000.0 / cycles_ms[cycles_ms.size() / 2];
   const double rate = 2.0 * sustainable_hz;
   const double period_ms = 1000.0 / rate;
   const size_t first = h.received_.size();

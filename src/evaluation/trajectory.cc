@@ -157,6 +157,76 @@ Eigen::Vector3d rotation_difference_deg(const Eigen::Matrix3d& a, const Eigen::M
   return aa.angle() * aa.axis() * 180.0 / M_PI;
 }
 
+RotationOffsetFit fit_rotation_offset(const std::vector<Eigen::Matrix3d>& reference,
+                                      const std::vector<Eigen::Matrix3d>& measured) {
+  RotationOffsetFit fit;
+  const size_t n = reference.size();
+  if (n < 3 || measured.size() != n) return fit;
+  // e = scale * theta - [theta]x tilt: three rows per pair, four unknowns.
+  Eigen::MatrixXd A(3 * n, 4);
+  Eigen::VectorXd e(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    if (!reference[i].allFinite() || !measured[i].allFinite()) return fit;
+    const Eigen::AngleAxisd aa(reference[i]);
+    const Eigen::Vector3d theta = aa.angle() * aa.axis();
+    Eigen::Matrix3d skew;
+    skew << 0, -theta.z(), theta.y(), theta.z(), 0, -theta.x(), -theta.y(), theta.x(), 0;
+    A.block<3, 1>(3 * i, 0) = theta;
+    A.block<3, 3>(3 * i, 1) = -skew;
+    e.segment<3>(3 * i) = rotation_difference_deg(reference[i], measured[i]) * M_PI / 180.0;
+  }
+  // Least squares on the pairs in `keep`; false when the rotations cannot tell the four numbers
+  // apart (rotations about one axis only leave the tilt about it unobservable).
+  auto solve = [&](const std::vector<char>& keep, Eigen::Vector4d* x) {
+    const int m = static_cast<int>(std::count(keep.begin(), keep.end(), 1));
+    if (m < 3) return false;
+    Eigen::MatrixXd As(3 * m, 4);
+    Eigen::VectorXd es(3 * m);
+    for (size_t i = 0, k = 0; i < n; ++i)
+      if (keep[i]) {
+        As.middleRows<3>(3 * k) = A.middleRows<3>(3 * i);
+        es.segment<3>(3 * k++) = e.segment<3>(3 * i);
+      }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(As, Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const Eigen::VectorXd& sv = svd.singularValues();
+    if (!(sv(0) > 0.0) || !(sv(3) > 1e-3 * sv(0))) return false;
+    *x = svd.solve(es);
+    return x->allFinite();
+  };
+  // A measurement that failed is an outlier of the fit, not a frame offset. The pairs within 3
+  // times the median of a residual are kept: first of the difference itself, then of the fit.
+  auto keep_within_3_medians = [&](const Eigen::Vector4d& x, std::vector<char>* keep) {
+    std::vector<double> residual(n);
+    for (size_t i = 0; i < n; ++i)
+      residual[i] = (e.segment<3>(3 * i) - A.middleRows<3>(3 * i) * x).norm();
+    std::vector<double> sorted = residual;
+    std::nth_element(sorted.begin(), sorted.begin() + n / 2, sorted.end());
+    for (size_t i = 0; i < n; ++i) (*keep)[i] = residual[i] <= 3.0 * sorted[n / 2];
+  };
+  std::vector<char> keep(n, 1);
+  Eigen::Vector4d x = Eigen::Vector4d::Zero();
+  keep_within_3_medians(x, &keep);
+  if (!solve(keep, &x)) return fit;
+  keep_within_3_medians(x, &keep);
+  if (!solve(keep, &x)) return fit;
+  double before = 0.0, after = 0.0;
+  int rows = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!keep[i]) continue;
+    before += e.segment<3>(3 * i).squaredNorm();
+    after += (e.segment<3>(3 * i) - A.middleRows<3>(3 * i) * x).squaredNorm();
+    rows += 3;
+  }
+  const double to_deg = 180.0 / M_PI;
+  fit.ok = true;
+  fit.pairs = rows / 3;
+  fit.scale = x(0);
+  fit.tilt_deg = x.tail<3>() * to_deg;
+  fit.rms_before_deg = std::sqrt(before / rows) * to_deg;
+  fit.rms_after_deg = std::sqrt(after / rows) * to_deg;
+  return fit;
+}
+
 bool read_tum_trajectory(const std::string& path, Trajectory* trajectory, std::string* error) {
   std::ifstream in(path);
   if (!in) {

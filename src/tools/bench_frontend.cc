@@ -84,6 +84,7 @@ void print_direct_check(const std::vector<cv::Mat>& images, const CameraModel& c
   std::vector<ImageFeatures> features;
   for (const cv::Mat& image : images) features.push_back(extract_features(image, frontend));
   std::vector<Eigen::Vector3d> chained, true_minus_direct;
+  std::vector<Eigen::Matrix3d> true_rotations, direct_rotations;
   for (size_t i = 0; i + gap < images.size(); ++i) {
     const TwoViewMatches matches =
         match_features(features[i], features[i + gap], camera, camera, frontend);
@@ -92,9 +93,12 @@ void print_direct_check(const std::vector<cv::Mat>& images, const CameraModel& c
     if (direct.status != EstimationStatus::kOk) continue;
     chained.push_back(evaluation::rotation_difference_deg(
         evaluation::relative_rotation(odometry[i], odometry[i + gap]), direct.pose.R));
-    if (i + gap < truth.size())
-      true_minus_direct.push_back(evaluation::rotation_difference_deg(
-          evaluation::relative_rotation(truth[i], truth[i + gap]), direct.pose.R));
+    if (i + gap < truth.size()) {
+      true_rotations.push_back(evaluation::relative_rotation(truth[i], truth[i + gap]));
+      direct_rotations.push_back(direct.pose.R);
+      true_minus_direct.push_back(
+          evaluation::rotation_difference_deg(true_rotations.back(), direct.pose.R));
+    }
   }
   const size_t pairs = images.size() > static_cast<size_t>(gap) ? images.size() - gap : 0;
   std::printf("rotation over %d frames against a direct two-view estimate (%zu of %zu pairs "
@@ -102,7 +106,16 @@ void print_direct_check(const std::vector<cv::Mat>& images, const CameraModel& c
               gap, chained.size(), pairs);
   if (chained.empty()) return;
   print_difference("odometry", chained);
-  if (!true_minus_direct.empty()) print_difference("truth", true_minus_direct);
+  if (true_minus_direct.empty()) return;
+  print_difference("truth", true_minus_direct);
+  // A constant part of truth - direct is the truth's (or the calibration's), not estimation's.
+  const evaluation::RotationOffsetFit fit =
+      evaluation::fit_rotation_offset(true_rotations, direct_rotations);
+  if (fit.ok)
+    std::printf("  truth - direct, fitted: the truth turns %+.2f %% more, about axes tilted by "
+                "%.3f %.3f %.3f deg (camera); rms %.4f -> %.4f deg over %d pairs\n",
+                100.0 * fit.scale, fit.tilt_deg.x(), fit.tilt_deg.y(), fit.tilt_deg.z(),
+                fit.rms_before_deg, fit.rms_after_deg, fit.pairs);
 }
 
 double cpu_ms() { return 1000.0 * static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }

@@ -60,6 +60,23 @@ Eigen::Matrix3d relative_rotation(const StampedPose& from, const StampedPose& to
 // axis (in the frame both map into).
 Eigen::Vector3d rotation_difference_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 
+// How a reference's relative rotations differ from measured ones of the same motions, to first
+// order: e = log(R_reference R_measured^T) ~ scale * theta + tilt x theta, theta the reference's
+// rotation vector. `scale` is a rotation-rate error; `tilt` a constant rotation between the two
+// frames, which turns every rotation axis. Least squares over the pairs whose difference is
+// within 3 times the median, refitted on those whose residual is (failed measurements are
+// outliers, not an offset); ok false with fewer
+// than 3 pairs, non-finite input or rotations too small to tell the four numbers apart.
+struct RotationOffsetFit {
+  bool ok = false;
+  int pairs = 0;  // kept in the refit
+  double scale = 0.0;                                  // 0.01: the reference turns 1 % more
+  Eigen::Vector3d tilt_deg = Eigen::Vector3d::Zero();  // rotation vector, degrees
+  double rms_before_deg = 0.0, rms_after_deg = 0.0;    // per component, before and after the fit
+};
+RotationOffsetFit fit_rotation_offset(const std::vector<Eigen::Matrix3d>& reference,
+                                      const std::vector<Eigen::Matrix3d>& measured);
+
 // TUM format: "timestamp tx ty tz qx qy qz qw" per line, '#' comments. False with file:line.
 bool read_tum_trajectory(const std::string& path, Trajectory* trajectory, std::string* error);
 // Writes the same format (stamps to the microsecond, positions and quaternions to 1e-9), which
