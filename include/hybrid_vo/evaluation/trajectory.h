@@ -65,8 +65,8 @@ Eigen::Vector3d rotation_difference_deg(const Eigen::Matrix3d& a, const Eigen::M
 // rotation vector. `scale` is a rotation-rate error; `tilt` a constant rotation between the two
 // frames, which turns every rotation axis. Least squares over the pairs whose difference is
 // within 3 times the median, refitted on those whose residual is (failed measurements are
-// outliers, not an offset); ok false with fewer
-// than 3 pairs, non-finite input or rotations too small to tell the four numbers apart.
+// outliers, not an offset). ok is false with fewer than 3 pairs, sizes that differ, non-finite
+// input, or rotations too small (or about one axis only) to tell the four numbers apart.
 struct RotationOffsetFit {
   bool ok = false;
   int pairs = 0;  // kept in the refit
