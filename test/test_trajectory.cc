@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "hybrid_vo/evaluation/trajectory.h"
+#include "hybrid_vo/geometry/rotation.h"
 
 namespace hybrid_vo {
 namespace evaluation {
@@ -18,7 +19,7 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Matrix3d rotation(const Eigen::Vector3d& axis, double degrees) {
-  return Eigen::AngleAxisd(degrees * kDeg, axis.normalized()).toRotationMatrix();
+  return rotation_about(axis.normalized(), degrees * kDeg);
 }
 
 Trajectory random_trajectory(int n, unsigned seed) {

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/pose_error.h"
 
 namespace hybrid_vo {
@@ -169,10 +170,8 @@ RotationOffsetFit fit_rotation_offset(const std::vector<Eigen::Matrix3d>& refere
     if (!reference[i].allFinite() || !measured[i].allFinite()) return fit;
     const Eigen::AngleAxisd aa(reference[i]);
     const Eigen::Vector3d theta = aa.angle() * aa.axis();
-    Eigen::Matrix3d skew;
-    skew << 0, -theta.z(), theta.y(), theta.z(), 0, -theta.x(), -theta.y(), theta.x(), 0;
     A.block<3, 1>(3 * i, 0) = theta;
-    A.block<3, 3>(3 * i, 1) = -skew;
+    A.block<3, 3>(3 * i, 1) = -skew(theta);
     e.segment<3>(3 * i) = rotation_difference_deg(reference[i], measured[i]) * M_PI / 180.0;
   }
   // Least squares on the pairs in `keep`; false when the rotations cannot tell the four numbers

@@ -471,9 +471,8 @@ int main(int argc, char** argv) {
         if (args.opencv) {
           double ms = 0.0;
           RelativePose pose;
-          const bool ok = run_opencv(matches, c0.pinhole, c1.pinhole,
-                                     args.point_threshold > 0.0 ? args.point_threshold : 1.0, seed,
-                                     &ms, &pose);
+          const bool ok =
+              run_opencv(matches, c0.pinhole, c1.pinhole, threshold_px, seed, &ms, &pose);
           record("opencv_usac_magsac", ok ? rotation_error(pose.R, truth.R) * kDeg : kFailed,
                  ok ? translation_error(pose.t, truth.t) * kDeg : kFailed, ms, 0,
                  ok ? &pose : nullptr, false);
