@@ -33,6 +33,34 @@ TEST(Junctions, ToleranceBeyondTheEnds) {
   EXPECT_EQ(find_junctions(lines, options).size(), 0u);
 }
 
+// Issue 30: a faint corner breaks its edges off short of it. With length_fraction 0.15, a
+// 100 px segment meeting another at a right angle may stop up to 15 px short, a 40 px one 6 px
+// (the 3 px floor below that), never more than max_tolerance_px, and less at shallow angles.
+TEST(Junctions, LongSegmentsThatStopShortOfACornerStillMeetIt) {
+  JunctionOptions options;
+  options.tolerance_px = 3.0;
+  options.length_fraction = 0.15;
+  options.max_tolerance_px = 20.0;
+  EXPECT_DOUBLE_EQ(junction_tolerance_px(100.0, 1.0, options), 15.0);
+  EXPECT_DOUBLE_EQ(junction_tolerance_px(40.0, 1.0, options), 6.0);
+  EXPECT_DOUBLE_EQ(junction_tolerance_px(10.0, 1.0, options), 3.0);
+  EXPECT_DOUBLE_EQ(junction_tolerance_px(400.0, 1.0, options), 20.0);
+  EXPECT_DOUBLE_EQ(junction_tolerance_px(100.0, 0.5, options), 7.5);
+  // An L corner on the floor: both edges 100 px long, each stopping 12 px short of it.
+  auto corner = [](double gap, double length) {
+    return std::vector<LineMatch>{match({0, 0}, {length, 0}),
+                                  match({length + gap, gap}, {length + gap, gap + length})};
+  };
+  EXPECT_EQ(find_junctions(corner(12.0, 100.0), options).size(), 1u);
+  EXPECT_EQ(find_junctions(corner(16.0, 100.0), options).size(), 0u);
+  // Short edges must reach closer: 40 px ones meet 5 px short, not 8.
+  EXPECT_EQ(find_junctions(corner(5.0, 40.0), options).size(), 1u);
+  EXPECT_EQ(find_junctions(corner(8.0, 40.0), options).size(), 0u);
+  // The default (length_fraction 0) keeps the fixed 3 px.
+  EXPECT_EQ(find_junctions(corner(12.0, 100.0)).size(), 0u);
+  EXPECT_EQ(find_junctions(corner(2.0, 100.0)).size(), 1u);
+}
+
 TEST(Junctions, MustHoldInBothImages) {
   std::vector<LineMatch> lines = {match({0, 0}, {100, 0}), match({50, -40}, {50, 60})};
   lines[1].s2 = LineSegment({200, 10}, {200, 90});  // far from the other segment in image 2

@@ -453,6 +453,61 @@ TEST(CameraModel, UndistortMatchesUndistortsEachImageWithItsCamera) {
 }
 
 // Degenerate input: empty results, no crash.
+// Issue 30, white panels: a dark last row and column (TUM's Kinect frames) are no scene lines;
+// panel edges of a few grey levels are found only when the threshold follows the contrast; and
+// a faint edge that breaks up is joined again.
+TEST(LineDetection, IgnoresTheImageBorderAndFindsFaintEdgesWhole) {
+  cv::Mat image(240, 320, CV_8UC1, cv::Scalar(120));
+  cv::rectangle(image, cv::Rect(80, 60, 140, 110), cv::Scalar(126), cv::FILLED);  // faint panel
+  image.row(image.rows - 1).setTo(25);
+  image.col(image.cols - 1).setTo(25);
+  cv::GaussianBlur(image, image, cv::Size(3, 3), 0.8);
+  LineDetectionOptions options;
+  options.min_length_px = 30.0;
+  options.detector = LineDetector::kLsd;  // LSD finds the border's edge (FLD's Canny does not)
+  for (const LineSegment& s : detect_line_segments(image, options))
+    EXPECT_FALSE(along_image_border(s, image.cols, image.rows, 2.0))
+        << s.p1.transpose() << " - " << s.p2.transpose();
+  options.border_margin_px = 0.0;
+  int along = 0;
+  for (const LineSegment& s : detect_line_segments(image, options))
+    along += along_image_border(s, image.cols, image.rows, 2.0);
+  EXPECT_GE(along, 1) << "the border is an edge to the detector itself";
+
+  options.detector = LineDetector::kFld;
+  options.border_margin_px = 2.0;
+  EXPECT_TRUE(detect_line_segments(image, options).empty()) << "6 grey levels: below FLD's 50";
+  options.adapt_to_contrast = true;
+  EXPECT_LT(line_gradient_threshold(image, options), kFldDefaultGradient);
+  const std::vector<LineSegment> faint = detect_line_segments(image, options);
+  EXPECT_GE(faint.size(), 4u);
+  double longest = 0.0;
+  for (const LineSegment& s : faint) longest = std::max(longest, s.length());
+  EXPECT_GT(longest, 100.0);
+  // A strong image keeps the detector's own threshold.
+  cv::Mat strong(240, 320, CV_8UC1, cv::Scalar(40));
+  cv::rectangle(strong, cv::Rect(80, 60, 140, 110), cv::Scalar(220), cv::FILLED);
+  EXPECT_DOUBLE_EQ(line_gradient_threshold(strong, options), kFldDefaultGradient);
+
+  // A dashed edge, 40 px pieces 8 px apart, is one segment once joined; a parallel edge 6 px
+  // away is another.
+  std::vector<LineSegment> pieces;
+  for (int k = 0; k < 5; ++k)
+    pieces.push_back(LineSegment({20.0 + 48 * k, 100.0}, {60.0 + 48 * k, 100.4}));
+  pieces.push_back(LineSegment({20.0, 106.0}, {200.0, 106.0}));
+  options.merge_collinear = true;
+  const std::vector<LineSegment> joined = merge_collinear_segments(pieces, options);
+  ASSERT_EQ(joined.size(), 2u);
+  const LineSegment& dashed = joined[0].midpoint().y() < joined[1].midpoint().y() ? joined[0]
+                                                                                 : joined[1];
+  const LineSegment& parallel = &dashed == &joined[0] ? joined[1] : joined[0];
+  EXPECT_NEAR(dashed.length(), 232.0, 1.0);
+  EXPECT_NEAR(dashed.midpoint().y(), 100.2, 0.3);
+  EXPECT_NEAR(parallel.midpoint().y(), 106.0, 1e-9);
+  options.merge_gap_px = 5.0;
+  EXPECT_EQ(merge_collinear_segments(pieces, options).size(), 6u);
+}
+
 TEST(FrontendMatching, EmptyAndBlackImagesGiveEmptyResults) {
   const cv::Mat empty, black(kHeight, kWidth, CV_8U, cv::Scalar(0));
   const cv::Mat black_bgr(kHeight, kWidth, CV_8UC3, cv::Scalar(0, 0, 0));

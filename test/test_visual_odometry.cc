@@ -1,6 +1,6 @@
 // The video front end on a rendered sequence: the threaded front end gives exactly the matches
-// and poses of the sequential one, line tracking is as correct as full LBD matching and finds
-// at least as many matches, the stereo scale's current points do not lag on approaching
+// and poses of the sequential one, segment tracking is as correct as full LBD matching without
+// using any point, the stereo scale's current points do not lag on approaching
 // surfaces, and the worker thread and the tracker behave at their edges.
 #include <algorithm>
 #include <cmath>
@@ -149,19 +149,25 @@ double line_error_px(const RenderedView& view1, const CameraPose& pose1, const C
   return worst;
 }
 
-TEST_F(VideoFrontEnd, LineTrackingIsAsCorrectAsLbdMatchingAndFindsMore) {
+TEST_F(VideoFrontEnd, SegmentTracksAreAsCorrectAsLbdMatchingWithoutAnyPoint) {
   const PinholeCamera& cam = sequence_->camera;
   const LineMatchingOptions matching = video_line_matching_options();
-  KltTracker klt;
-  int lbd_total = 0, lbd_wrong = 0, tracked_total = 0, tracked_wrong = 0, by_search = 0;
-  klt.track((*left_)[0].image);
+  LineTracker tracker;
+  int lbd_total = 0, lbd_wrong = 0, tracked_total = 0, tracked_wrong = 0;
   LineFeatures previous = detect_line_features((*left_)[0].image, matching);
+  std::vector<int64_t> previous_ids = tracker.track(previous, input(0, false).stamp);
   for (int i = 1; i < kFrames; ++i) {
-    const std::vector<PointMatch> points = klt.track((*left_)[i].image);
     const LineFeatures current = detect_line_features((*left_)[i].image, matching);
     LineTrackingStats stats;
-    const std::vector<LineMatch> tracked =
-        track_line_segments(previous, current, points, matching, {}, &stats);
+    const std::vector<int64_t> ids = tracker.track(current, input(i, false).stamp, &stats);
+    ASSERT_EQ(ids.size(), current.segments.size());
+    EXPECT_EQ(stats.matched + stats.started, static_cast<int>(current.segments.size()));
+    EXPECT_LE(stats.ambiguous, stats.matched);
+    std::vector<LineMatch> by_id;
+    for (size_t j = 0; j < ids.size(); ++j)
+      for (size_t k = 0; k < previous_ids.size(); ++k)
+        if (previous_ids[k] == ids[j]) by_id.push_back({previous.segments[k], current.segments[j]});
+    const std::vector<LineMatch>& tracked = by_id;
     const std::vector<LineMatch> lbd = match_line_features(previous, current, matching);
     const CameraPose pose1 = frame_pose(*sequence_, i - 1), pose2 = frame_pose(*sequence_, i);
     for (const auto& [matches, total, wrong] :
@@ -173,19 +179,16 @@ TEST_F(VideoFrontEnd, LineTrackingIsAsCorrectAsLbdMatchingAndFindsMore) {
         wrong += e > 3.0;
       }
     }
-    EXPECT_EQ(stats.tracked + stats.fallback, static_cast<int>(tracked.size()));
-    EXPECT_LE(stats.ambiguous, stats.tracked);
-    by_search += stats.tracked;
     previous = current;
+    previous_ids = ids;
   }
   ASSERT_GT(lbd_total, 100);
-  EXPECT_GE(tracked_total, lbd_total);
+  // Ids link most segments of consecutive frames, as many as LBD matches or nearly.
+  EXPECT_GE(tracked_total, 0.8 * lbd_total) << tracked_total << " vs " << lbd_total;
   // Precision no worse than LBD's (one wrong match of slack on ~100s of matches).
   EXPECT_LE(static_cast<double>(tracked_wrong) / tracked_total,
             static_cast<double>(lbd_wrong + 1) / lbd_total)
       << tracked_wrong << " of " << tracked_total << " vs " << lbd_wrong << " of " << lbd_total;
-  // Most matches come from the search, not the fallback.
-  EXPECT_GT(by_search, tracked_total / 2);
 }
 
 // The stereo scale's near points (closer than 40 baselines) in the current image, against the
@@ -258,11 +261,16 @@ ScalePointErrors scale_point_errors(const Sequence& seq,
 // where the pose's epipolar test cannot see it. Affine refinement removes the lag.
 TEST_F(VideoFrontEnd, StereoScalePointsDoNotLagOnApproachingSurfaces) {
   auto in = [](int i) { return input(i, true); };
-  VisualOdometryOptions klt_points;
+  // Every corner the detector finds, weak ones too: those lag the most (with the default
+  // klt.min_corner_gradient half of them are not tracked, and the lag is -0.009 px, refined
+  // -0.005).
+  VisualOdometryOptions defaults;
+  defaults.klt.min_corner_gradient = 0.0;
+  VisualOdometryOptions klt_points = defaults;
   klt_points.stereo_refine_tracks = false;
   klt_points.stereo_scale.point_sigma_px = 0.5;  // the weight the KLT's points had
   const ScalePointErrors tracked = scale_point_errors(*sequence_, in, klt_points);
-  const ScalePointErrors refined = scale_point_errors(*sequence_, in, VisualOdometryOptions());
+  const ScalePointErrors refined = scale_point_errors(*sequence_, in, defaults);
   ASSERT_GT(tracked.along.size(), 1000u);
   ASSERT_GT(refined.along.size(), 1000u);
   std::vector<double> a = tracked.scale_ratio, b = refined.scale_ratio;
@@ -317,28 +325,117 @@ TEST(KltTracker, StampsCarryThePredictionOverADroppedFrame) {
   EXPECT_GT(correct_with, correct_without + with / 10) << correct_without << " of " << without;
 }
 
-TEST(LineTracker, WithoutPointMatchesItIsFullLbdMatching) {
-  cv::Mat image(240, 320, CV_8UC1, cv::Scalar(40));
-  cv::rectangle(image, cv::Rect(60, 50, 120, 90), cv::Scalar(200), cv::FILLED);
-  cv::rectangle(image, cv::Rect(200, 120, 80, 80), cv::Scalar(120), cv::FILLED);
-  cv::line(image, cv::Point(20, 220), cv::Point(300, 200), cv::Scalar(230), 3);
+// A synthetic scene of a bright and a grey rectangle, shifted `shift` pixels to the right.
+cv::Mat moving_rectangles(double shift, bool without_second = false) {
+  cv::Mat image(240, 400, CV_8UC1, cv::Scalar(40));
+  const cv::Matx23d move(1, 0, shift, 0, 1, 0);
+  cv::Mat scene(240, 400, CV_8UC1, cv::Scalar(40));
+  cv::rectangle(scene, cv::Rect(60, 50, 120, 90), cv::Scalar(200), cv::FILLED);
+  if (!without_second) cv::rectangle(scene, cv::Rect(200, 120, 80, 80), cv::Scalar(120), cv::FILLED);
+  cv::warpAffine(scene, image, move, image.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  return image;
+}
+
+TEST(LineTracker, KeepsIdsThroughMotionAndAMissedFrameAndStartsAfreshBackwards) {
   const LineMatchingOptions matching = video_line_matching_options();
-  const LineFeatures a = detect_line_features(image, matching);
-  ASSERT_GT(a.segments.size(), 4u);
-  std::vector<std::pair<int, int>> tracked_pairs, lbd_pairs;
+  LineTracker tracker;
+  const LineFeatures first = detect_line_features(moving_rectangles(0.0), matching);
+  ASSERT_GE(first.segments.size(), 6u);
+  const std::vector<int64_t> first_ids = tracker.track(first, 0.0);
+  // Constant motion of 6 px per frame: young tracks are found within their wider window, then
+  // the prediction follows; every segment keeps its id.
+  std::vector<int64_t> ids;
+  LineFeatures current;
+  for (int frame = 1; frame <= 4; ++frame) {
+    current = detect_line_features(moving_rectangles(6.0 * frame), matching);
+    LineTrackingStats stats;
+    ids = tracker.track(current, 0.1 * frame, &stats);
+    EXPECT_EQ(stats.started, 0) << "frame " << frame;
+    EXPECT_EQ(stats.matched, static_cast<int>(current.segments.size())) << "frame " << frame;
+  }
+  std::vector<int64_t> sorted_first = first_ids, sorted_now = ids;
+  std::sort(sorted_first.begin(), sorted_first.end());
+  std::sort(sorted_now.begin(), sorted_now.end());
+  EXPECT_EQ(sorted_first, sorted_now);
+
+  // The second rectangle is missed once: its tracks coast and keep their ids when it is back.
+  const LineFeatures missing = detect_line_features(moving_rectangles(30.0, true), matching);
+  ASSERT_LT(missing.segments.size(), current.segments.size());
   LineTrackingStats stats;
-  track_line_segments(a, a, {}, matching, {}, &stats, &tracked_pairs);
-  match_line_features(a, a, matching, &lbd_pairs);
-  EXPECT_EQ(tracked_pairs, lbd_pairs);
-  EXPECT_EQ(stats.predicted, 0);
-  EXPECT_EQ(stats.fallback, static_cast<int>(lbd_pairs.size()));
-  // And without the fallback, nothing.
-  LineTrackingOptions no_fallback;
-  no_fallback.descriptor_fallback = false;
-  EXPECT_TRUE(track_line_segments(a, a, {}, matching, no_fallback).empty());
-  // Empty inputs give no matches.
-  EXPECT_TRUE(track_line_segments(LineFeatures(), a, {}, matching).empty());
-  EXPECT_TRUE(track_line_segments(a, LineFeatures(), {}, matching).empty());
+  tracker.track(missing, 0.5, &stats);
+  EXPECT_EQ(stats.started, 0);
+  const LineFeatures back = detect_line_features(moving_rectangles(36.0), matching);
+  const std::vector<int64_t> back_ids = tracker.track(back, 0.6, &stats);
+  EXPECT_EQ(stats.started, 0);
+  std::vector<int64_t> sorted_back = back_ids;
+  std::sort(sorted_back.begin(), sorted_back.end());
+  EXPECT_EQ(sorted_first, sorted_back);
+
+  // Missed for longer than max_missed_frames: dropped, and new ids when it comes back.
+  LineTrackerOptions options;
+  for (int k = 0; k < options.max_missed_frames + 1; ++k)
+    tracker.track(detect_line_features(moving_rectangles(42.0 + 6 * k, true), matching),
+                  0.7 + 0.1 * k);
+  tracker.track(detect_line_features(moving_rectangles(42.0 + 6 * (options.max_missed_frames + 1)),
+                                     matching),
+                0.7 + 0.1 * (options.max_missed_frames + 1), &stats);
+  EXPECT_GT(stats.dropped + stats.started, 0);
+  EXPECT_GT(stats.started, 0);
+
+  // Time going backwards starts afresh: every segment gets a new track.
+  const LineFeatures again = detect_line_features(moving_rectangles(0.0), matching);
+  const std::vector<int64_t> again_ids = tracker.track(again, 0.0, &stats);
+  EXPECT_EQ(stats.tracks, 0);
+  EXPECT_EQ(stats.started, static_cast<int>(again.segments.size()));
+  for (const int64_t id : again_ids)
+    EXPECT_EQ(std::count(sorted_first.begin(), sorted_first.end(), id), 0);
+}
+
+TEST(LineTracker, NeverTakesAnEdgeOfOppositeContrastAndHandlesEmptyFrames) {
+  const LineMatchingOptions matching = video_line_matching_options();
+  // A bright bar on dark ground, then the same bar dark on bright ground: the same lines, every
+  // edge of the opposite contrast.
+  cv::Mat bright(200, 200, CV_8UC1, cv::Scalar(40)), dark(200, 200, CV_8UC1, cv::Scalar(200));
+  cv::rectangle(bright, cv::Rect(60, 40, 60, 120), cv::Scalar(200), cv::FILLED);
+  cv::rectangle(dark, cv::Rect(60, 40, 60, 120), cv::Scalar(40), cv::FILLED);
+  LineTracker tracker;
+  const LineFeatures a = detect_line_features(bright, matching);
+  ASSERT_GE(a.segments.size(), 2u);
+  tracker.track(a, 0.0);
+  LineTrackingStats stats;
+  const LineFeatures b = detect_line_features(dark, matching);
+  ASSERT_GE(b.segments.size(), 2u);
+  tracker.track(b, 0.1, &stats);
+  EXPECT_EQ(stats.matched, 0);
+  EXPECT_EQ(stats.started, static_cast<int>(b.segments.size()));
+  // An empty frame matches nothing and starts nothing; tracks coast.
+  EXPECT_TRUE(tracker.track(LineFeatures(), 0.2, &stats).empty());
+  EXPECT_EQ(stats.matched + stats.started, 0);
+  EXPECT_GT(tracker.num_tracks(), 0);
+}
+
+// Issue 30: a cell of white wall still yields goodFeaturesToTrack's relative "corners" of faint
+// texture; with min_corner_gradient only real corners are tracked.
+TEST(KltTracker, FaintTextureIsNotTrackedStrongCornersAre) {
+  cv::Mat image(240, 320, CV_8UC1, cv::Scalar(180));
+  cv::Mat texture(240, 320, CV_8UC1);
+  cv::randu(texture, 0, 3);  // +-1.5 grey levels of "fabric"
+  cv::GaussianBlur(texture, texture, cv::Size(5, 5), 1.5);
+  image += texture;
+  for (int k = 0; k < 4; ++k)  // four dark squares: 16 strong corners
+    cv::rectangle(image, cv::Rect(40 + 60 * k, 100, 30, 30), cv::Scalar(60), cv::FILLED);
+  KltTrackerOptions options;
+  options.max_features = 300;
+  KltTracker all(options);
+  all.track(image);
+  options.min_corner_gradient = 1.5;
+  KltTracker strong(options);
+  strong.track(image);
+  EXPECT_GT(all.num_tracks(), 60) << "every cell finds its faint corners";
+  EXPECT_GE(strong.num_tracks(), 12);
+  EXPECT_LE(strong.num_tracks(), 20);
+  for (const cv::Point2f& p : strong.points())
+    EXPECT_TRUE(p.y > 95 && p.y < 135) << p;  // on the squares only
 }
 
 TEST(WorkerThread, RunsJobsInOrderAndRethrowsTheirErrors) {

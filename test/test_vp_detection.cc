@@ -199,6 +199,47 @@ TEST(JointVpDetection, ManhattanPriorDropsAnObliqueDirection) {
   EXPECT_GE(prior.matches.size(), 2u);
 }
 
+// Issue 30: a white room has a handful of long edges. Three long segments of one direction are a
+// VP when long-segment evidence is on (three segments of 150 px per image), three short ones are
+// not, and with the count rule alone (6) neither is.
+TEST(JointVpDetection, AVpFromThreeLongSegments) {
+  const PinholeCamera camera(500, 500, 320, 240, 640, 480);
+  const Eigen::Matrix3d R = rotation_about(Eigen::Vector3d(0.2, 1.0, 0.1), 3.0 * kDeg);
+  const Eigen::Vector3d t(0.05, 0.0, 0.01);
+  const Eigen::Vector3d vertical = Eigen::Vector3d(0.05, 1.0, 0.2).normalized();
+  const Eigen::Vector3d across = vertical.cross(Eigen::Vector3d::UnitZ()).normalized();
+  auto project = [&](const Eigen::Vector3d& X, bool second) {
+    const Eigen::Vector3d Y = second ? Eigen::Vector3d(R * X + t) : X;
+    return Eigen::Vector2d(camera.fx * Y.x() / Y.z() + camera.cx,
+                           camera.fy * Y.y() / Y.z() + camera.cy);
+  };
+  auto segments_along = [&](const Eigen::Vector3d& d, const std::vector<Eigen::Vector3d>& starts,
+                            double length, std::vector<LineMatch>* out) {
+    for (const Eigen::Vector3d& X : starts)
+      out->push_back({LineSegment(project(X, false), project(X + length * d, false)),
+                      LineSegment(project(X, true), project(X + length * d, true))});
+  };
+  const std::vector<Eigen::Vector3d> starts = {
+      {-1.0, -0.8, 3.0}, {0.2, -0.7, 3.5}, {1.1, -0.9, 3.2}};
+  std::vector<LineMatch> long_lines, short_lines;
+  segments_along(vertical, starts, 1.6, &long_lines);   // ~230 px each
+  segments_along(vertical, starts, 0.25, &short_lines);  // ~35 px each
+  // Two segments across, so that the pencil is not the only direction.
+  for (auto* lines : {&long_lines, &short_lines})
+    segments_along(across, {{-1.2, 0.6, 3.0}, {-0.8, 0.9, 3.4}}, 0.8, lines);
+  VpDetectionOptions options;
+  options.min_inliers = 6;
+  EXPECT_TRUE(detect_vanishing_points_joint(camera, camera, long_lines, options).matches.empty());
+  options.min_long_inliers = 3;
+  options.min_support_px = 150.0;
+  const MatchedVps found = detect_vanishing_points_joint(camera, camera, long_lines, options);
+  ASSERT_EQ(found.matches.size(), 1u);
+  EXPECT_LT(axis_angle_deg(found.matches[0].d1, vertical), 0.05);
+  EXPECT_LT(axis_angle_deg(found.matches[0].d2, R * vertical), 0.05);
+  EXPECT_EQ(found.inliers[0], (std::vector<int>{0, 1, 2}));
+  EXPECT_TRUE(detect_vanishing_points_joint(camera, camera, short_lines, options).matches.empty());
+}
+
 TEST(VpDetectionBadInput, FewParallelOrNanSegmentsGiveNothing) {
   const PinholeCamera camera(600, 600, 400, 300, 800, 600);
   std::vector<LineMatch> few = {

@@ -521,3 +521,97 @@ TEST(VpTracker, CapOnTheNumberOfTracks) {
 
 }  // namespace
 }  // namespace hybrid_vo
+
+namespace hybrid_vo {
+namespace {
+
+// Issue 30: confident tracks anchor a drifted orientation. The camera truly sits at R_true; the
+// odometry believes R_true turned by 2 degrees.
+struct AnchorScene {
+  VpTracker tracker;
+  Eigen::Matrix3d R_true = camera_to_world(10);
+  Eigen::Matrix3d R_drifted =
+      rotation_about(Eigen::Vector3d(0.3, 1.0, -0.2).normalized(), 2.0 * kDeg) * R_true;
+  std::vector<VpObservation> seen;  // the three directions as the true camera sees them
+
+  AnchorScene() {
+    for (int k = 0; k < 4; ++k)
+      tracker.update(camera_to_world(k), observations({camera_to_world(k).transpose() * kManhattan[0],
+                                                       camera_to_world(k).transpose() * kManhattan[1],
+                                                       camera_to_world(k).transpose() * kManhattan[2]},
+                                                      0.1));
+    for (const Eigen::Vector3d& axis : kManhattan)
+      seen.push_back(observation(R_true.transpose() * axis, 0.2));
+  }
+};
+
+double rotation_angle_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a * b.transpose()).angle() / kDeg;
+}
+
+TEST(VpTracker, AnchorPullsADriftedOrientationBackWhereItIsUncertain) {
+  AnchorScene s;
+  const double sigma = 1.5 * kDeg;  // the drift the odometry admits to
+  const Eigen::Matrix3d P = sigma * sigma * Eigen::Matrix3d::Identity();
+  const AnchoredOrientation a = s.tracker.anchor(s.R_drifted, P, s.seen);
+  EXPECT_EQ(a.anchors, 3);
+  EXPECT_EQ(a.rejected, 0);
+  EXPECT_LT(rotation_angle_deg(a.R_world_from_camera, s.R_true), 0.15);
+  EXPECT_NEAR(a.correction_deg, 2.0, 0.15);
+  EXPECT_LT(a.covariance.trace(), 0.1 * P.trace());
+  // Not a rotation any more than it was: orthonormal, proper.
+  EXPECT_LT((a.R_world_from_camera.transpose() * a.R_world_from_camera -
+             Eigen::Matrix3d::Identity()).norm(), 1e-9);
+  // Tracks are not touched by anchoring.
+  EXPECT_EQ(s.tracker.tracks().size(), 3u);
+}
+
+TEST(VpTracker, AnchorTrustsACertainOrientationOverVpsThatDisagree) {
+  AnchorScene s;
+  // The odometry claims 0.05 degrees: 2 degrees of disagreement is the VPs' fault.
+  const double sigma = 0.05 * kDeg;
+  const AnchoredOrientation a =
+      s.tracker.anchor(s.R_drifted, sigma * sigma * Eigen::Matrix3d::Identity(), s.seen);
+  EXPECT_EQ(a.anchors, 0);
+  EXPECT_EQ(a.rejected, 3);
+  EXPECT_EQ(a.R_world_from_camera, s.R_drifted);
+  // With a true orientation, one VP 2.5 degrees off (inside the association angle) is the one
+  // left out.
+  std::vector<VpObservation> one_wrong = s.seen;
+  one_wrong[1] = observation(
+      rotation_about(Eigen::Vector3d(1, 0, 0), 2.5 * kDeg) * one_wrong[1].direction, 0.2);
+  const double loose = 0.5 * kDeg;
+  const AnchoredOrientation b =
+      s.tracker.anchor(s.R_true, loose * loose * Eigen::Matrix3d::Identity(), one_wrong);
+  EXPECT_EQ(b.anchors, 2);
+  EXPECT_EQ(b.rejected, 1);
+  EXPECT_LT(rotation_angle_deg(b.R_world_from_camera, s.R_true), 0.1);
+}
+
+TEST(VpTracker, AnchorWithoutTracksOrWithBadInputChangesNothing) {
+  AnchorScene s;
+  const Eigen::Matrix3d P = 1e-3 * Eigen::Matrix3d::Identity();
+  const VpTracker empty;
+  AnchoredOrientation a = empty.anchor(s.R_drifted, P, s.seen);
+  EXPECT_EQ(a.anchors + a.rejected, 0);
+  EXPECT_EQ(a.R_world_from_camera, s.R_drifted);
+  Eigen::Matrix3d nan_rotation = s.R_drifted;
+  nan_rotation(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  a = s.tracker.anchor(nan_rotation, P, s.seen);
+  EXPECT_EQ(a.anchors, 0);
+  Eigen::Matrix3d nan_covariance = P;
+  nan_covariance(1, 1) = std::numeric_limits<double>::infinity();
+  a = s.tracker.anchor(s.R_drifted, nan_covariance, s.seen);
+  EXPECT_EQ(a.anchors, 0);
+  EXPECT_EQ(a.R_world_from_camera, s.R_drifted);
+  std::vector<VpObservation> bad = s.seen;
+  bad[0].direction.setZero();
+  bad[1].direction.x() = std::numeric_limits<double>::quiet_NaN();
+  a = s.tracker.anchor(s.R_drifted, P, bad);
+  EXPECT_LE(a.anchors, 1);
+  EXPECT_TRUE(all_finite(a.R_world_from_camera));
+  EXPECT_TRUE(all_finite(a.covariance));
+}
+
+}  // namespace
+}  // namespace hybrid_vo

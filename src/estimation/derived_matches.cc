@@ -1,5 +1,6 @@
 #include "hybrid_vo/estimation/derived_matches.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hybrid_vo {
@@ -18,22 +19,29 @@ SegmentGeometry geometry_of(const LineSegment& s) {
   return g;
 }
 
-// Intersection of two segments' lines when it lies on both (within `tolerance` pixels past an
+// Intersection of two segments' lines when it lies on both (within each one's tolerance past an
 // end) and they cross at an angle whose sine is at least `min_sin`.
-bool intersect_segments(const SegmentGeometry& a, const SegmentGeometry& b, double tolerance,
-                        double min_sin, Eigen::Vector2d* x) {
+bool intersect_segments(const SegmentGeometry& a, const SegmentGeometry& b,
+                        const JunctionOptions& options, double min_sin, Eigen::Vector2d* x) {
   const double cross = a.direction.x() * b.direction.y() - a.direction.y() * b.direction.x();
   if (std::abs(cross) < min_sin) return false;
   const Eigen::Vector2d d = b.origin - a.origin;
   const double ta = (d.x() * b.direction.y() - d.y() * b.direction.x()) / cross;
   const double tb = (d.x() * a.direction.y() - d.y() * a.direction.x()) / cross;
-  if (ta < -tolerance || ta > a.length + tolerance) return false;
-  if (tb < -tolerance || tb > b.length + tolerance) return false;
+  const double tolerance_a = junction_tolerance_px(a.length, std::abs(cross), options);
+  const double tolerance_b = junction_tolerance_px(b.length, std::abs(cross), options);
+  if (ta < -tolerance_a || ta > a.length + tolerance_a) return false;
+  if (tb < -tolerance_b || tb > b.length + tolerance_b) return false;
   *x = a.origin + ta * a.direction;
   return true;
 }
 
 }  // namespace
+
+double junction_tolerance_px(double length, double sin_angle, const JunctionOptions& options) {
+  const double grown = options.length_fraction * length * sin_angle;
+  return std::max(options.tolerance_px, std::min(grown, options.max_tolerance_px));
+}
 
 bool valid_segment(const LineSegment& s, double min_length) {
   return all_finite(s.p1) && all_finite(s.p2) && s.length() > min_length;
@@ -57,8 +65,8 @@ std::vector<DerivedPoint> find_junctions(const std::vector<LineMatch>& lines,
     for (int j = i + 1; j < n; ++j) {
       if (!valid[j]) continue;
       DerivedPoint jp;
-      if (!intersect_segments(g1[i], g1[j], options.tolerance_px, min_sin, &jp.match.x1)) continue;
-      if (!intersect_segments(g2[i], g2[j], options.tolerance_px, min_sin, &jp.match.x2)) continue;
+      if (!intersect_segments(g1[i], g1[j], options, min_sin, &jp.match.x1)) continue;
+      if (!intersect_segments(g2[i], g2[j], options, min_sin, &jp.match.x2)) continue;
       jp.source = PointSource::kJunction;
       jp.first = i;
       jp.second = j;

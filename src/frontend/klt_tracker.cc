@@ -32,6 +32,30 @@ void search(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>
                       found);
 }
 
+// The weaker eigenvalue of the structure tensor of `gray` over a window x window square at p, as
+// an RMS gradient (Sobel / 8: grey levels per pixel); 0 where the window leaves the image.
+double corner_gradient(const cv::Mat& gray, const cv::Point2f& p, int window) {
+  const int r = window / 2 + 1;  // one more pixel for the derivative's support
+  const cv::Rect box(static_cast<int>(std::lround(p.x)) - r, static_cast<int>(std::lround(p.y)) - r,
+                     2 * r + 1, 2 * r + 1);
+  if ((box & cv::Rect(0, 0, gray.cols, gray.rows)) != box) return 0.0;
+  cv::Mat gx, gy;
+  cv::Sobel(gray(box), gx, CV_32F, 1, 0, 3, 0.125);
+  cv::Sobel(gray(box), gy, CV_32F, 0, 1, 3, 0.125);
+  double xx = 0.0, xy = 0.0, yy = 0.0;
+  for (int y = 1; y < box.height - 1; ++y)
+    for (int x = 1; x < box.width - 1; ++x) {
+      const double a = gx.at<float>(y, x), b = gy.at<float>(y, x);
+      xx += a * a;
+      xy += a * b;
+      yy += b * b;
+    }
+  const double n = (box.width - 2.0) * (box.height - 2.0);
+  const double half_trace = 0.5 * (xx + yy), det = xx * yy - xy * xy;
+  const double weaker = half_trace - std::sqrt(std::max(0.0, half_trace * half_trace - det));
+  return std::sqrt(std::max(0.0, weaker) / n);
+}
+
 }  // namespace
 
 KltTracker::KltTracker(const KltTrackerOptions& options) : options_(options) {}
@@ -215,8 +239,12 @@ void KltTracker::detect_new() {
       std::vector<cv::Point2f> corners;
       cv::goodFeaturesToTrack(gray(cell), corners, missing, options_.quality_level,
                               options_.min_distance_px, mask(cell));
-      for (const cv::Point2f& c : corners) {
-        points_.push_back(c + cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y)));
+      for (const cv::Point2f& c0 : corners) {
+        const cv::Point2f c = c0 + cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y));
+        if (options_.min_corner_gradient > 0.0 &&
+            corner_gradient(gray, c, options_.window_px) < options_.min_corner_gradient)
+          continue;
+        points_.push_back(c);
         motion_.push_back(cv::Point2f(kUnknown, kUnknown));
         ids_.push_back(next_id_++);
       }

@@ -1,13 +1,152 @@
 #include "hybrid_vo/frontend/line_detection.h"
 
 #include <algorithm>
+#include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/ximgproc.hpp>
 
 #include "hybrid_vo/frontend/gray_image.h"
 
 namespace hybrid_vo {
+namespace {
+
+// The given percentile of the gradient magnitude (Sobel / 8: grey levels per pixel), from a
+// histogram of 0.25 grey-level bins.
+double gradient_percentile(const cv::Mat& gray, double percentile) {
+  cv::Mat gx, gy, magnitude;
+  cv::Sobel(gray, gx, CV_32F, 1, 0, 3, 0.125);
+  cv::Sobel(gray, gy, CV_32F, 0, 1, 3, 0.125);
+  cv::magnitude(gx, gy, magnitude);
+  constexpr double kBin = 0.25;
+  constexpr int kBins = 1024;
+  std::vector<int> histogram(kBins, 0);
+  for (int r = 0; r < magnitude.rows; ++r) {
+    const float* row = magnitude.ptr<float>(r);
+    for (int c = 0; c < magnitude.cols; ++c)
+      ++histogram[std::min(kBins - 1, static_cast<int>(row[c] / kBin))];
+  }
+  const double wanted = std::clamp(percentile, 0.0, 100.0) / 100.0 * magnitude.total();
+  double seen = 0.0;
+  for (int b = 0; b < kBins; ++b) {
+    seen += histogram[b];
+    if (seen >= wanted) return (b + 1) * kBin;
+  }
+  return kBins * kBin;
+}
+
+// A merged segment: its fragments' endpoints, each weighted by half its fragment's length.
+struct Chain {
+  std::vector<Eigen::Vector2d> points;
+  std::vector<double> weights;
+  LineSegment segment;
+
+  void add(const LineSegment& s) {
+    points.push_back(s.p1);
+    points.push_back(s.p2);
+    weights.push_back(0.5 * s.length());
+    weights.push_back(0.5 * s.length());
+  }
+  // The weighted total-least-squares line of the points, spanned by their extreme projections.
+  void fit() {
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    double total = 0.0;
+    for (size_t k = 0; k < points.size(); ++k) {
+      mean += weights[k] * points[k];
+      total += weights[k];
+    }
+    mean /= total;
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (size_t k = 0; k < points.size(); ++k)
+      scatter += weights[k] * (points[k] - mean) * (points[k] - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
+    Eigen::Vector2d u = eig.eigenvectors().col(1);
+    // Keep the direction of the chain's first (longest) fragment.
+    if (u.dot(points[1] - points[0]) < 0.0) u = -u;
+    double lo = 0.0, hi = 0.0;
+    for (size_t k = 0; k < points.size(); ++k) {
+      const double t = u.dot(points[k] - mean);
+      lo = k == 0 ? t : std::min(lo, t);
+      hi = k == 0 ? t : std::max(hi, t);
+    }
+    segment = LineSegment(mean + lo * u, mean + hi * u);
+  }
+};
+
+// Whether fragment t continues chain segment s: the same direction, on its line, and near it.
+bool continues(const LineSegment& s, const LineSegment& t, double cos_angle, double offset,
+               double gap) {
+  const double ls = s.length(), lt = t.length();
+  if (!(ls > 0.0) || !(lt > 0.0)) return false;
+  const Eigen::Vector2d us = (s.p2 - s.p1) / ls, ut = (t.p2 - t.p1) / lt;
+  if (std::abs(us.dot(ut)) < cos_angle) return false;
+  const Eigen::Vector2d n(-us.y(), us.x());
+  if (std::abs(n.dot(t.p1 - s.p1)) > offset || std::abs(n.dot(t.p2 - s.p1)) > offset) return false;
+  const double a = us.dot(t.p1 - s.p1), b = us.dot(t.p2 - s.p1);
+  const double separation = std::max({0.0, std::min(a, b) - ls, -std::max(a, b)});
+  return separation <= gap;
+}
+
+double default_gradient(LineDetector detector) {
+  return detector == LineDetector::kLsd ? kLsdDefaultGradient : kFldDefaultGradient;
+}
+
+}  // namespace
+
+bool along_image_border(const LineSegment& s, int width, int height, double margin) {
+  if (!(margin > 0.0)) return false;
+  auto near = [margin](double a, double b, double side) {
+    return std::abs(a - side) <= margin && std::abs(b - side) <= margin;
+  };
+  return near(s.p1.x(), s.p2.x(), 0.0) || near(s.p1.x(), s.p2.x(), width - 1.0) ||
+         near(s.p1.y(), s.p2.y(), 0.0) || near(s.p1.y(), s.p2.y(), height - 1.0);
+}
+
+double line_gradient_threshold(const cv::Mat& gray, const LineDetectionOptions& options) {
+  const double fixed = default_gradient(options.detector);
+  if (!options.adapt_to_contrast || gray.empty()) return fixed;
+  // Inside the border, whose artefacts (a dark last row) would otherwise set the contrast.
+  const int margin = 2 + static_cast<int>(std::ceil(std::max(0.0, options.border_margin_px)));
+  const cv::Rect inside(margin, margin, gray.cols - 2 * margin, gray.rows - 2 * margin);
+  if (inside.width < 3 || inside.height < 3) return fixed;
+  const double adapted =
+      options.contrast_fraction * gradient_percentile(gray(inside), options.contrast_percentile);
+  return std::clamp(adapted, std::min(options.min_gradient, fixed), fixed);
+}
+
+std::vector<LineSegment> merge_collinear_segments(std::vector<LineSegment> segments,
+                                                  const LineDetectionOptions& options) {
+  std::stable_sort(segments.begin(), segments.end(),
+                   [](const LineSegment& a, const LineSegment& b) {
+                     return a.length() > b.length();
+                   });
+  const double cos_angle = std::cos(options.merge_angle_deg * M_PI / 180.0);
+  std::vector<char> used(segments.size(), 0);
+  std::vector<LineSegment> merged;
+  for (size_t i = 0; i < segments.size(); ++i) {
+    if (used[i]) continue;
+    used[i] = 1;
+    Chain chain;
+    chain.add(segments[i]);
+    chain.segment = segments[i];
+    // Joining a fragment moves the chain's line a little, which may bring others within reach.
+    for (bool grown = true; grown;) {
+      grown = false;
+      for (size_t j = i + 1; j < segments.size(); ++j) {
+        if (used[j] || !continues(chain.segment, segments[j], cos_angle, options.merge_offset_px,
+                                  options.merge_gap_px))
+          continue;
+        used[j] = 1;
+        chain.add(segments[j]);
+        chain.fit();
+        grown = true;
+      }
+    }
+    merged.push_back(chain.segment);
+  }
+  return merged;
+}
 
 std::vector<LineSegment> detect_line_segments(const cv::Mat& image,
                                               const LineDetectionOptions& options) {
@@ -16,16 +155,33 @@ std::vector<LineSegment> detect_line_segments(const cv::Mat& image,
   const cv::Mat gray = to_gray8(image);
 
   std::vector<cv::Vec4f> raw;
+  const double gradient = line_gradient_threshold(gray, options);
+  // Fragments shorter than the final minimum may still join into a long segment.
+  const double min_raw_length =
+      options.merge_collinear ? 0.5 * options.min_length_px : options.min_length_px;
+  const bool lowered = gradient < default_gradient(options.detector);
   if (options.detector == LineDetector::kLsd) {
-    cv::createLineSegmentDetector(cv::LSD_REFINE_STD)->detect(gray, raw);
+    // LSD's gradient threshold is quant / sin(ang_th), ang_th 22.5 degrees; its default quant 2.
+    const double quant = lowered ? gradient * std::sin(22.5 * M_PI / 180.0) : 2.0;
+    cv::createLineSegmentDetector(cv::LSD_REFINE_STD, 0.8, 0.6, quant)->detect(gray, raw);
   } else {
-    const int min_length = static_cast<int>(std::max(1.0, options.min_length_px));
-    cv::ximgproc::createFastLineDetector(min_length)->detect(gray, raw);
+    const int min_length = static_cast<int>(std::max(1.0, min_raw_length));
+    const double canny = lowered ? 8.0 * gradient : 50.0;
+    cv::ximgproc::createFastLineDetector(min_length, 1.414213562f, canny, canny)->detect(gray, raw);
   }
   for (const cv::Vec4f& r : raw) {
     LineSegment s({r[0], r[1]}, {r[2], r[3]});
-    if (all_finite(s.p1) && all_finite(s.p2) && s.length() >= options.min_length_px)
+    if (all_finite(s.p1) && all_finite(s.p2) && s.length() >= min_raw_length &&
+        !along_image_border(s, gray.cols, gray.rows, options.border_margin_px))
       segments.push_back(s);
+  }
+  if (options.merge_collinear) {
+    segments = merge_collinear_segments(std::move(segments), options);
+    segments.erase(std::remove_if(segments.begin(), segments.end(),
+                                  [&](const LineSegment& s) {
+                                    return !(s.length() >= options.min_length_px);
+                                  }),
+                   segments.end());
   }
   if (options.max_segments > 0 && static_cast<int>(segments.size()) > options.max_segments) {
     std::partial_sort(segments.begin(), segments.begin() + options.max_segments, segments.end(),

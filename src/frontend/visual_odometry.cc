@@ -49,6 +49,15 @@ bool uses_vps(const RelativePoseEstimatorOptions& options) {
 VisualOdometryOptions::VisualOdometryOptions() {
   features.points = video_point_matching_options();
   features.lines = video_line_matching_options();
+  // Low texture (issue 30, README "Low texture"): a VP may rest on three long segments, and
+  // segments that stop short of a corner still meet.
+  estimator.vp_detection.min_long_inliers = 3;
+  estimator.vp_detection.min_support_px = 150.0;
+  estimator.estimator.junctions.length_fraction = 0.15;
+  // A scene direction does not go away: a track survives a few seconds unseen, and is not dropped
+  // for disagreeing with the odometry, which is what it exists to correct (anchor_orientation).
+  vp_tracker.max_misses = 60;
+  vp_tracker.max_gate_failures = 0;
 }
 
 const char* to_string(VoStatus status) {
@@ -75,6 +84,7 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
     : options_(options),
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
       klt_(options.klt),
+      line_tracker_(options.line_tracking),
       vp_tracker_(options.vp_tracker),
       offset_filter_(options.stereo_offset) {}
 
@@ -90,12 +100,14 @@ std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
 void VisualOdometry::reset() {
   restart();
   R_wc_.setIdentity();
+  R_wc_covariance_.setZero();
   centre_.setZero();
   last_stamp_ = -1e300;
 }
 
 void VisualOdometry::restart() {
   klt_.reset();
+  line_tracker_.reset();
   vp_tracker_.reset();
   keyframe_ = Keyframe();
   tracker_seeded_ = false;
@@ -139,17 +151,20 @@ std::map<int64_t, Eigen::Vector3d> VisualOdometry::stereo_of(
 void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
                                    const std::map<int64_t, Eigen::Vector2d>& points,
                                    std::map<int64_t, Eigen::Vector3d> points3d,
-                                   ImageFeatures features) {
+                                   ImageFeatures features, const std::vector<int64_t>& line_ids) {
   keyframe_ = Keyframe();
   keyframe_.valid = true;
   keyframe_.stamp = input.stamp;
   keyframe_.points = points;
   keyframe_.points3d = std::move(points3d);
+  for (size_t i = 0; i < line_ids.size() && i < features.lines.segments.size(); ++i)
+    keyframe_.tracked_lines[line_ids[i]] = features.lines.segments[i];
   keyframe_.features = std::move(features);
   keyframe_.camera = input.camera;
   // A copy: the caller may reuse its image buffer for the next frame.
   if (options_.stereo_refine_tracks && !input.right_image.empty()) keyframe_.image = gray.clone();
   keyframe_.R_wc = R_wc_;
+  keyframe_.R_wc_covariance = R_wc_covariance_;
   keyframe_.centre = centre_;
   if (input.external.has_lines)
     for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i)
@@ -257,6 +272,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   // Features of this frame: the segments on the second thread while this one does the points.
   std::map<int64_t, Eigen::Vector2d> points;
   ImageFeatures features;
+  std::vector<int64_t> line_ids;  // with track_lines: the track of each segment
   WorkerJob lines_job, redetect_job;
   const bool tracking =
       !input.external.has_points && options_.point_source == PointFeatureSource::kTracking;
@@ -264,6 +280,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     lines_job = worker_->submit([&] {
       const auto lines_start = std::chrono::steady_clock::now();
       features.lines = detect_line_features(gray, options_.features.lines);
+      if (options_.track_lines)
+        line_ids = line_tracker_.track(features.lines, input.stamp, &r.line_tracking);
       times.lines_ms = ms_since(lines_start);
     });
   }
@@ -314,7 +332,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     redetect_job.get();
     stereo_job.get();
     make_keyframe(input, gray, tracking ? klt_points() : points, std::move(points3d),
-                  std::move(features));
+                  std::move(features), line_ids);
     r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
     r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
     r.reference_stamp = input.stamp;
@@ -346,12 +364,16 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     }
   } else if (options_.use_lines) {
     const auto matching_start = std::chrono::steady_clock::now();
-    m.lines = options_.track_lines
-                  ? track_line_segments(keyframe_.features.lines, features.lines, m.points,
-                                        options_.features.lines, options_.line_tracking,
-                                        &r.line_tracking)
-                  : match_line_features(keyframe_.features.lines, features.lines,
-                                        options_.features.lines);
+    if (options_.track_lines) {
+      for (size_t i = 0; i < line_ids.size(); ++i) {
+        const auto it = keyframe_.tracked_lines.find(line_ids[i]);
+        if (it != keyframe_.tracked_lines.end())
+          m.lines.push_back({it->second, features.lines.segments[i]});
+      }
+    } else {
+      m.lines = match_line_features(keyframe_.features.lines, features.lines,
+                                    options_.features.lines);
+    }
     times.line_matching_ms = ms_since(matching_start);
   }
   r.num_point_matches = static_cast<int>(m.points.size());
@@ -363,7 +385,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     redetect_job.get();
     stereo_job.get();
     make_keyframe(input, gray, tracking ? klt_points() : points, std::move(points3d),
-                  std::move(features));
+                  std::move(features), line_ids);
     r.status = VoStatus::kTooFewFeatures;
     r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
@@ -446,46 +468,14 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     return r;
   }
 
-  // Scale: the keyframe's stereo points seen again, with this frame's disparities, fitted in
-  // disparity and image space (estimate_stereo_scale); without a usable fit, the configured
-  // length and scale_known false.
+  // Orientation: the pair's rotation, anchored by the VP tracks it sees (VpTracker::anchor).
   redetect_job.get();
   stereo_job.get();
-  std::map<int64_t, Eigen::Vector3d> current3d = std::move(points3d);
-  r.motion = est.pose;
-  double scale = options_.mono_scale, scale_sigma = 0.0;
-  if (stereo) {
-    r.stereo_scale_attempted = true;
-    const auto scale_start = std::chrono::steady_clock::now();
-    r.scale_observations = scale_observations(input, gray, m, point_ids, est.point_inliers,
-                                              points, current3d, tracking);
-    const StereoRig rig{input.camera.pinhole.fx, input.camera.pinhole.fy, input.baseline_m};
-    offset_filter_.update(est.pose, rig, r.scale_observations, options_.stereo_scale);
-    StereoScaleOptions scale_options = options_.stereo_scale;
-    scale_options.disparity_offset_px = r.disparity_offset_px = offset_filter_.offset();
-    r.stereo_scale = estimate_stereo_scale(est.pose, rig, r.scale_observations, scale_options);
-    if (r.stereo_scale.status == StereoScaleStatus::kOk) {
-      scale = r.stereo_scale.scale;
-      scale_sigma = r.stereo_scale.sigma;
-      r.scale_known = true;
-    }
-    times.scale_ms = ms_since(scale_start);
-  }
-  r.motion.t = est.pose.t * scale;
-  if (est.covariance_valid) {
-    r.motion_covariance = metric_motion_covariance(est.covariance, est.pose.t, scale, scale_sigma);
-    r.motion_covariance_valid = true;
-  }
-
-  // Integrate: the current camera's centre in the keyframe is -R^T t.
-  R_wc_ = nearest_rotation(keyframe_.R_wc * r.motion.R.transpose());
-  centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
-  r.R_wc = R_wc_;
-  r.centre = centre_;
+  RelativePose pose = est.pose;
+  std::vector<VpObservation> seen;  // the VPs the pose accepts, as seen in image 2
   if (options_.use_vp_tracker) {
-    // Every estimated frame, also without VPs, so that misses count. Only the VPs the pose
-    // accepts, each with the covariance of its fit to image 2's segments at the pair's measured
-    // segment noise.
+    // Each with the covariance of its fit to image 2's segments at the pair's measured segment
+    // noise.
     TwoViewMatches inliers;
     inliers.lines = m.lines;
     inliers.line_vp = m.line_vp;
@@ -496,12 +486,70 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       inliers.vps.push_back(m.vps[k]);
     }
     for (int& label : inliers.line_vp) label = label >= 0 ? kept[label] : -1;
-    r.vp_associations = vp_tracker_.update(
-        R_wc_, vp_observations(input.camera.pinhole.K(), inliers, true, est.scales.line_vp_px,
-                               est.scales.vp_deg));
+    seen = vp_observations(input.camera.pinhole.K(), inliers, true, est.scales.line_vp_px,
+                           est.scales.vp_deg);
   }
+  Eigen::Matrix3d R_wc = nearest_rotation(keyframe_.R_wc * pose.R.transpose());
+  {
+    // The pair's rotation error as a left increment of R (camera 2) is -R_wc times it in the
+    // odometry frame.
+    const double floor = options_.rotation_drift_floor_deg * M_PI / 180.0;
+    const double scale = options_.rotation_covariance_scale;
+    R_wc_covariance_ = keyframe_.R_wc_covariance + floor * floor * Eigen::Matrix3d::Identity();
+    if (est.covariance_valid)
+      R_wc_covariance_ +=
+          scale * scale * R_wc * est.covariance.topLeftCorner<3, 3>() * R_wc.transpose();
+  }
+  if (options_.use_vp_tracker && options_.anchor_orientation) {
+    r.anchoring = vp_tracker_.anchor(R_wc, R_wc_covariance_, seen);
+    R_wc_covariance_ = r.anchoring.covariance;
+    // The correction is the drift of earlier pairs, not this pair's motion: the translation
+    // stays as this pair's points fixed it (re-fitted under the anchored rotation, it was 37 ->
+    // 51 deg off on TUM fr3 structure_notexture).
+    if (r.anchoring.anchors > 0) {
+      R_wc = r.anchoring.R_world_from_camera;
+      pose.R = nearest_rotation(R_wc.transpose() * keyframe_.R_wc);
+    }
+  }
+
+  // Scale: the keyframe's stereo points seen again, with this frame's disparities, fitted in
+  // disparity and image space (estimate_stereo_scale); without a usable fit, the configured
+  // length and scale_known false.
+  std::map<int64_t, Eigen::Vector3d> current3d = std::move(points3d);
+  r.motion = pose;
+  double scale = options_.mono_scale, scale_sigma = 0.0;
+  if (stereo) {
+    r.stereo_scale_attempted = true;
+    const auto scale_start = std::chrono::steady_clock::now();
+    r.scale_observations = scale_observations(input, gray, m, point_ids, est.point_inliers,
+                                              points, current3d, tracking);
+    const StereoRig rig{input.camera.pinhole.fx, input.camera.pinhole.fy, input.baseline_m};
+    offset_filter_.update(pose, rig, r.scale_observations, options_.stereo_scale);
+    StereoScaleOptions scale_options = options_.stereo_scale;
+    scale_options.disparity_offset_px = r.disparity_offset_px = offset_filter_.offset();
+    r.stereo_scale = estimate_stereo_scale(pose, rig, r.scale_observations, scale_options);
+    if (r.stereo_scale.status == StereoScaleStatus::kOk) {
+      scale = r.stereo_scale.scale;
+      scale_sigma = r.stereo_scale.sigma;
+      r.scale_known = true;
+    }
+    times.scale_ms = ms_since(scale_start);
+  }
+  r.motion.t = pose.t * scale;
+  if (est.covariance_valid) {
+    r.motion_covariance = metric_motion_covariance(est.covariance, pose.t, scale, scale_sigma);
+    r.motion_covariance_valid = true;
+  }
+
+  // Integrate: the current camera's centre in the keyframe is -R^T t.
+  R_wc_ = R_wc;
+  centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
+  r.R_wc = R_wc_;
+  r.centre = centre_;
+  // Every estimated frame, also without VPs, so that misses count.
+  if (options_.use_vp_tracker) r.vp_associations = vp_tracker_.update(R_wc_, seen);
   make_keyframe(input, gray, tracking ? klt_points() : points, std::move(current3d),
-                std::move(features));
+                std::move(features), line_ids);
   r.status = VoStatus::kOk;
   r.message = "ok";
   r.total_ms = ms_since(start);

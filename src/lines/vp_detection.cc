@@ -71,7 +71,7 @@ class VpFitter {
     std::vector<int> active(items_.size());
     std::iota(active.begin(), active.end(), 0);
     while (static_cast<int>(models.size()) < options_.max_vps &&
-           static_cast<int>(active.size()) >= std::max(2, options_.min_inliers)) {
+           static_cast<int>(active.size()) >= std::max(2, min_count())) {
       Model model;
       if (!ransac(active, &model)) break;
       // Refit on the inliers and take the inliers again: the minimal sample is noisy.
@@ -83,7 +83,7 @@ class VpFitter {
       for (int i : model.inliers) taken[i] = 1;
       active.erase(std::remove_if(active.begin(), active.end(), [&](int i) { return taken[i]; }),
                    active.end());
-      if (static_cast<int>(model.inliers.size()) < options_.min_inliers) continue;
+      if (!enough(model.inliers)) continue;
       if (options_.manhattan && !orthogonal_to_all(model, models)) continue;
       models.push_back(model);
     }
@@ -98,6 +98,19 @@ class VpFitter {
   }
 
   const std::vector<Item>& items() const { return items_; }
+
+  // Enough evidence for a VP: min_inliers segments, or min_long_inliers of min_support_px in all
+  // per image.
+  bool enough(const std::vector<int>& inliers) const {
+    const int count = static_cast<int>(inliers.size());
+    if (count >= options_.min_inliers) return true;
+    return options_.min_long_inliers > 0 && count >= std::max(2, options_.min_long_inliers) &&
+           score_of(inliers) >= options_.min_support_px * views_;
+  }
+  int min_count() const {
+    return options_.min_long_inliers > 0 ? std::min(options_.min_inliers, options_.min_long_inliers)
+                                         : options_.min_inliers;
+  }
 
   // Distance of item i to the model: the worse view.
   double distance(const Model& m, int i) const {
@@ -226,9 +239,7 @@ class VpFitter {
       for (Model& m : *models) fit_directions(m.inliers, &m);
     }
     models->erase(std::remove_if(models->begin(), models->end(),
-                                 [this](const Model& m) {
-                                   return static_cast<int>(m.inliers.size()) < options_.min_inliers;
-                                 }),
+                                 [this](const Model& m) { return !enough(m.inliers); }),
                   models->end());
   }
 

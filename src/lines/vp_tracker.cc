@@ -241,6 +241,82 @@ std::vector<VpAssociation> VpTracker::update(const Eigen::Matrix3d& R_world_from
   return result;
 }
 
+AnchoredOrientation VpTracker::anchor(const Eigen::Matrix3d& R_world_from_camera,
+                                      const Eigen::Matrix3d& covariance,
+                                      const std::vector<VpObservation>& observations) const {
+  AnchoredOrientation out;
+  out.R_world_from_camera = R_world_from_camera;
+  out.covariance = covariance;
+  if (!is_rotation(R_world_from_camera) || !all_finite(covariance)) return out;
+  const size_t n = observations.size();
+  std::vector<Eigen::Vector3d> world(n, Eigen::Vector3d::Zero()), unit(n, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Matrix3d> world_covariance(n, Eigen::Matrix3d::Zero());
+  std::vector<char> valid(n, 0);
+  for (size_t i = 0; i < n; ++i) {
+    if (!unit_direction(observations[i].direction, &unit[i]) ||
+        !all_finite(observations[i].covariance))
+      continue;
+    world[i] = (R_world_from_camera * unit[i]).normalized();
+    world_covariance[i] =
+        observation_covariance(observations[i], R_world_from_camera, world[i], options_);
+    valid[i] = all_finite(world_covariance[i]);
+  }
+  std::vector<Eigen::Vector3d> track_directions;
+  std::vector<char> confident;
+  for (const VpTrack& track : tracks_) {
+    track_directions.push_back(track.direction);
+    confident.push_back(track.confident);
+  }
+  const double gate = std::max(options_.association_angle_deg, 0.0) * kDeg;
+  std::vector<double> angles;
+  const std::vector<int> track_of =
+      associate(world, valid, track_directions, confident, gate, &angles);
+  std::vector<int> order;
+  for (size_t i = 0; i < n; ++i)
+    if (track_of[i] >= 0) order.push_back(static_cast<int>(i));
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return (world_covariance[a] + tracks_[track_of[a]].covariance).trace() <
+           (world_covariance[b] + tracks_[track_of[b]].covariance).trace();
+  });
+
+  Eigen::Matrix3d R = R_world_from_camera, P = 0.5 * (covariance + covariance.transpose());
+  for (const int i : order) {
+    const VpTrack& track = tracks_[track_of[i]];
+    const Eigen::Vector3d& t = track.direction;
+    Eigen::Vector3d p = (R * unit[i]).normalized();
+    if (p.dot(t) < 0.0) p = -p;
+    // The observation in gnomonic coordinates of the track's tangent plane; a left increment w
+    // moves it by -B^T [p]x w.
+    const Eigen::Matrix<double, 3, 2> B = tangent_basis(t);
+    const Eigen::Vector2d y = B.transpose() * p / t.dot(p);
+    const Eigen::Matrix<double, 2, 3> H = -B.transpose() * skew(p);
+    const Eigen::Matrix2d S = H * P * H.transpose() +
+                              B.transpose() * (track.covariance + world_covariance[i]) * B;
+    const Eigen::FullPivLU<Eigen::Matrix2d> lu(S);
+    if (!lu.isInvertible()) continue;
+    const Eigen::Matrix2d S_inv = lu.inverse();
+    if (!(y.dot(S_inv * y) <= options_.gate_chi2)) {
+      ++out.rejected;
+      continue;
+    }
+    const Eigen::Matrix<double, 3, 2> K = P * H.transpose() * S_inv;
+    const Eigen::Vector3d w = -K * y;
+    const Eigen::Matrix3d P_next = (Eigen::Matrix3d::Identity() - K * H) * P;
+    if (!all_finite(w) || !all_finite(P_next)) continue;
+    R = Eigen::AngleAxisd(w.norm(), w.norm() > 0.0 ? Eigen::Vector3d(w / w.norm())
+                                                   : Eigen::Vector3d::UnitX())
+            .toRotationMatrix() *
+        R;
+    P = 0.5 * (P_next + P_next.transpose());
+    ++out.anchors;
+  }
+  const Eigen::AngleAxisd change(R * R_world_from_camera.transpose());
+  out.R_world_from_camera = R;
+  out.covariance = P;
+  out.correction_deg = change.angle() / kDeg;
+  return out;
+}
+
 std::vector<VpPrior> VpTracker::priors(const Eigen::Matrix3d& R_world_from_camera1,
                                        const std::vector<VpMatch>& matches) const {
   const size_t n = matches.size();

@@ -122,7 +122,9 @@ void VoNode::load_odometry_options() {
     o.estimator.vp_detection.min_inliers = 6;
   }
   o.use_vp_tracker = pnh_.param("vp_tracker", true);
-  o.track_lines = pnh_.param("track_lines", false);
+  o.track_lines = pnh_.param("track_lines", o.track_lines);
+  o.anchor_orientation = pnh_.param("anchor_orientation", o.anchor_orientation);
+  o.klt.min_corner_gradient = pnh_.param("klt_min_corner_gradient", o.klt.min_corner_gradient);
   o.klt.predict_motion = pnh_.param("klt_predict_motion", true);
   o.klt.window_px = pnh_.param("klt_window_px", o.klt.window_px);
   if (o.klt.window_px < 5) {

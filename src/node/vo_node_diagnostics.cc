@@ -104,8 +104,8 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("VPs (ms)", r.stages.vps_ms);
   status.add("RANSAC (ms)", r.stages.ransac_ms);
   status.add("stereo (ms)", r.stages.stereo_ms);
-  status.add("segments tracked", r.line_tracking.tracked);
-  status.add("segments matched by descriptor", r.line_tracking.fallback);
+  status.add("segment tracks found", r.line_tracking.matched);
+  status.add("segment tracks started", r.line_tracking.started);
 }
 
 void VoNode::add_vp_tracks(diagnostic_updater::DiagnosticStatusWrapper& status) const {

@@ -37,14 +37,17 @@ using evaluation::median;
 void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
-               " [--stereo] [--trajectory FILE] [--direct-gap G]\n"
+               " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
+               " [--no-anchor] [--no-vp-tracker] [--seed S] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
-               "  tracking; --no-predict: KLT without motion prediction. Default preset\n"
-               "  hybrid+junc. --trajectory: every frame's camera pose in the odometry frame, TUM\n"
-               "  format (timestamp tx ty tz qx qy qz qw; stamps from times.txt + 1 s, as\n"
-               "  kitti_to_bag writes them).\n"
+               "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
+               "  the KLT corners' strength floor (0: every corner); --no-anchor: no orientation\n"
+               "  anchoring by the VP tracks. Default preset hybrid+junc.\n"
+               "  --trajectory: every frame's camera pose in the odometry frame, TUM format\n"
+               "  (timestamp tx ty tz qx qy qz qw; stamps from times.txt + 1 s, as kitti_to_bag\n"
+               "  writes them).\n"
                "  --direct-gap G: a check without ground truth. Every frame i is also matched\n"
                "  directly with frame i+G (SIFT, the pair tools' front end) and `5pc` estimates\n"
                "  their rotation; the odometry's chained rotation over the same G frames, and the\n"
@@ -142,6 +145,8 @@ int run(int argc, char** argv) {
     else if (a == "--preset" && i + 1 < argc) preset = argv[++i];
     else if (a == "--sequential") o.concurrent = false;
     else if (a == "--lbd") o.track_lines = false;
+    else if (a == "--min-corner-gradient" && i + 1 < argc)
+      o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--stereo") stereo = true;
     else if (a == "--klt-window" && i + 1 < argc) o.klt.window_px = std::atoi(argv[++i]);
@@ -149,6 +154,7 @@ int run(int argc, char** argv) {
     else if (a == "--klt-levels" && i + 1 < argc) o.klt.pyramid_levels = std::atoi(argv[++i]);
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
+    else if (a == "--no-anchor") o.anchor_orientation = false;
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
     else if (a == "--direct-gap" && i + 1 < argc) {
@@ -246,9 +252,9 @@ int run(int argc, char** argv) {
 
   VisualOdometry vo(o);
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
-      stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, fallback;
+      stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, started;
   int ok = 0;
-  double lines_sum = 0.0, inliers_sum = 0.0, searched_sum[2] = {0, 0}, fallback_sum[2] = {0, 0};
+  double lines_sum = 0.0, inliers_sum = 0.0;
   const auto run_start = std::chrono::steady_clock::now();
   for (int i = 0; i < frames; ++i) {
     if (period_ms > 0.0)
@@ -315,6 +321,23 @@ int run(int argc, char** argv) {
           const Eigen::Vector3d w = (gt[i].R_wc * v.d2).normalized().cwiseAbs();
           std::printf(" %.3f", std::acos(std::min(1.0, w.maxCoeff())) * 180.0 / M_PI);
         }
+        // Anywhere: each VP match's disagreement with the true relative rotation, and its
+        // number of segments.
+        const int reference = frame_of(r.reference_stamp);
+        if (reference >= 0 && reference < i) {
+          const Eigen::Matrix3d R_true = gt[i].R_wc.transpose() * gt[reference].R_wc;
+          std::printf("\n   VP match error under the true rotation (deg, segments):");
+          for (size_t k = 0; k < r.matches.vps.size(); ++k) {
+            const VpMatch& v = r.matches.vps[k];
+            const double c = std::abs((R_true * v.d1.normalized()).dot(v.d2.normalized()));
+            int support = 0;
+            for (int label : r.matches.line_vp) support += label == static_cast<int>(k);
+            const Eigen::Vector3d d = v.d2.normalized();
+            std::printf(" %.3f (%d, d2 %.2f %.2f %.2f, track %d)",
+                        std::acos(std::min(1.0, c)) * 180.0 / M_PI, support, d.x(), d.y(), d.z(),
+                        k < r.vp_track_ids.size() ? r.vp_track_ids[k] : -1);
+          }
+        }
       }
       std::printf("\n   tracks:");
       for (const VpTrack& t : vo.vp_tracker().tracks()) {
@@ -356,15 +379,8 @@ int run(int argc, char** argv) {
     line_inliers.push_back(r.estimate.estimate.num_line_inliers);
     lines_sum += r.num_line_matches;
     inliers_sum += r.estimate.estimate.num_line_inliers;
-    // The tracker returns the searched matches first, then the fallback's.
-    const std::vector<char>& inlier = r.estimate.estimate.line_inliers;
-    for (size_t k = 0; k < inlier.size(); ++k) {
-      const bool searched = static_cast<int>(k) < r.line_tracking.tracked;
-      (searched ? searched_sum : fallback_sum)[0] += 1.0;
-      (searched ? searched_sum : fallback_sum)[1] += inlier[k] ? 1.0 : 0.0;
-    }
-    tracked.push_back(r.line_tracking.tracked);
-    fallback.push_back(r.line_tracking.fallback);
+    tracked.push_back(r.line_tracking.matched);
+    started.push_back(r.line_tracking.started);
   }
   std::printf("frames %d, estimated %d (%s, %s, %s)\n", frames, ok,
               o.concurrent ? "concurrent" : "sequential", o.track_lines ? "line tracking" : "LBD",
@@ -380,9 +396,9 @@ int run(int argc, char** argv) {
     std::printf("stereo: median %.1f ms (second thread); metric scale on %.0f of %d estimated pairs\n",
                 median(stereo_ms), n, ok);
   }
-  std::printf("median per estimated frame: line matches %.0f, line inliers %.0f, tracked %.0f, "
-              "by LBD fallback %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
-              median(line_matches), median(line_inliers), median(tracked), median(fallback),
+  std::printf("median per estimated frame: line matches %.0f, line inliers %.0f, segment tracks "
+              "found %.0f, started %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
+              median(line_matches), median(line_inliers), median(tracked), median(started),
               lines_sum > 0.0 ? inliers_sum / lines_sum : 0.0, lines_sum);
   if (!pose_errors.empty()) {
     const evaluation::TrajectoryErrors te =
@@ -405,10 +421,6 @@ int run(int argc, char** argv) {
     std::cerr << error << "\n";
     return 1;
   }
-  if (o.track_lines)
-    std::printf("line inlier ratio (pooled): searched %.3f of %.0f, LBD fallback %.3f of %.0f\n",
-                searched_sum[1] / std::max(1.0, searched_sum[0]), searched_sum[0],
-                fallback_sum[1] / std::max(1.0, fallback_sum[0]), fallback_sum[0]);
   return 0;
 }
 

@@ -17,8 +17,15 @@ struct DerivedPoint {
 };
 
 struct JunctionOptions {
-  // How far beyond a segment's end its intersection with the other segment may lie, in pixels.
+  // How far beyond a segment's end its intersection with the other segment may lie, in pixels:
+  // tolerance_px, or more for a long segment that meets the other steeply, length_fraction of
+  // its length times the sine of their angle, up to max_tolerance_px. A faint corner breaks its
+  // edges off short of it (white panels on a floor: 5-15 px), and a long segment that meets
+  // another at a right angle points at the corner precisely even from afar; extrapolated at a
+  // shallow angle, the intersection slides along the lines.
   double tolerance_px = 3.0;
+  double length_fraction = 0.0;
+  double max_tolerance_px = 20.0;
   // Junctions of nearly parallel segments are badly localised along the lines.
   double min_angle_deg = 15.0;
   // A junction within this distance of an earlier one in either image joins the point pool only
@@ -27,10 +34,14 @@ struct JunctionOptions {
 };
 
 // Junctions of segment matches (paper supp. Sec. B): pairs whose intersection lies on both
-// segments, up to the tolerance, in both images. Invalid (zero-length, non-finite) segments never
+// segments, up to the tolerance (junction_tolerance_px), in both images. Invalid (zero-length, non-finite) segments never
 // form junctions. O(n^2) in the number of segments.
 std::vector<DerivedPoint> find_junctions(const std::vector<LineMatch>& lines,
                                          const JunctionOptions& options = {});
+
+// How far past the end of a segment of `length` pixels that meets another at an angle whose sine
+// is `sin_angle` a junction may lie (JunctionOptions).
+double junction_tolerance_px(double length, double sin_angle, const JunctionOptions& options);
 
 // Indices of the junctions that do not repeat an earlier one: one within `radius_px` of an earlier
 // kept junction in image 1 or in image 2 is left out. One image position has one correspondence,

@@ -63,8 +63,9 @@ struct LineMatchingOptions {
 };
 
 // The video preset for consecutive frames (small baseline, little scale change, a 30 ms budget
-// for a KITTI pair): FLD segments of at least 30 px, one LBD octave at half resolution with 5 px
-// bands, about a third of the cost of one full-resolution octave with 7 px bands.
+// for a KITTI pair): FLD segments of at least 30 px, with the gradient threshold adapted to low
+// contrast and collinear fragments joined, one LBD octave at half resolution with 5 px bands,
+// about a third of the cost of one full-resolution octave with 7 px bands.
 LineMatchingOptions video_line_matching_options();
 
 // Segments and their LBD descriptors, one row each (octaves side by side: 72 floats or 32 bytes

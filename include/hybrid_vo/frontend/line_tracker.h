@@ -1,62 +1,84 @@
 #pragma once
 
-#include <utility>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
-#include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/frontend/line_matching.h"
 
 namespace hybrid_vo {
 
-// Line tracking in video: a keyframe segment is predicted into the current frame by the point
-// tracks around it and searched for near that prediction; the LBD descriptor decides only between
-// several candidates, and full LBD matching (match_line_features) takes the segments that the
-// search loses. Consecutive video frames change little, so the geometry alone tells most matches
-// apart, including those whose descriptors are too alike for the ratio test.
-struct LineTrackingOptions {
-  // Prediction: each endpoint moves like the median of its `neighbours` nearest point matches
-  // (by their keyframe position) within `max_neighbour_distance_px`. With fewer than
-  // `min_neighbours` at either endpoint the segment has no prediction.
-  int neighbours = 8;
-  int min_neighbours = 3;
-  double max_neighbour_distance_px = 80.0;
-  // Local search: a current segment is a candidate when both predicted endpoints lie within
-  // max_offset_px of its line, widened by the spread of the neighbours' motions (their median
-  // deviation from the median, at most max_spread_px); when its direction, oriented by the
-  // gradient as LBD orients it, is within max_angle_deg of the predicted one (so an edge of the
-  // opposite contrast is never a candidate); and when the two overlap along the line by at least
-  // min_overlap of the shorter.
+// Segment tracking in video by the segments' own geometry (issue 30): each track is predicted
+// from its own last image motion, searched for among the frame's detected segments near that
+// prediction, and keeps a stable id, as KLT does for points. Nothing depends on point flow, so
+// segments track where points cannot (white walls). The LBD descriptor only tells apart several
+// candidates near one prediction.
+struct LineTrackerOptions {
+  // A detected segment is a candidate for a track when its direction, oriented by the gradient
+  // (line_matching.h, so an edge of the opposite contrast never is), lies within max_angle_deg of
+  // the prediction; both predicted endpoints lie within the offset tolerance of its line; and
+  // the two overlap along the line by min_overlap of the shorter. The tolerance is
+  // max_offset_px plus motion_fraction of the predicted motion (constant velocity is a guess),
+  // and max_offset_young_px for a track seen once, which has no motion yet.
   double max_offset_px = 3.0;
-  double max_spread_px = 5.0;
-  double max_angle_deg = 5.0;
-  double min_overlap = 0.5;
-  // Several candidates that are not fragments of one edge are ambiguous: the nearest by LBD
+  double motion_fraction = 0.5;
+  double max_offset_young_px = 12.0;
+  double max_angle_deg = 4.0;
+  double young_angle_deg = 8.0;  // max_angle_deg of a track seen once
+  double min_overlap = 0.3;
+  // Candidates of one track that are not fragments of one edge are ambiguous: the nearest by LBD
   // distance wins when it is below the matching cap and below `ratio` times the second.
   double ratio = 0.8;
-  // Segments without a prediction or a candidate are matched by full LBD matching; its matches
-  // are kept for those segments only, and only with current segments the search left unmatched.
-  bool descriptor_fallback = true;
+  double max_lbd_distance = std::numeric_limits<double>::infinity();
+  // A track not found this many frames in a row is dropped; until then it coasts on its
+  // prediction, so a segment that the detector misses once keeps its id.
+  int max_missed_frames = 2;
 };
 
-// What happened to the keyframe's segments.
 struct LineTrackingStats {
-  int keyframe_segments = 0;
-  int predicted = 0;  // had a prediction
-  int tracked = 0;    // matched by the local search
+  int tracks = 0;     // tracks before this frame
+  int matched = 0;    // found in this frame
   int ambiguous = 0;  // of those, told apart by the descriptor
-  int fallback = 0;   // matched by full LBD matching
+  int started = 0;    // new tracks from this frame's unmatched segments
+  int dropped = 0;    // tracks missed for more than max_missed_frames
 };
 
-// Matches from `keyframe` to `current` segments (both described, as detect_line_features returns
-// them) given point matches from the keyframe to the current frame in the same pixels. `pairs`
-// receives the segment indices of each match. Deterministic: the order of the matches follows
-// the keyframe's segments, then the fallback's.
-std::vector<LineMatch> track_line_segments(const LineFeatures& keyframe,
-                                           const LineFeatures& current,
-                                           const std::vector<PointMatch>& point_matches,
-                                           const LineMatchingOptions& matching,
-                                           const LineTrackingOptions& options = {},
-                                           LineTrackingStats* stats = nullptr,
-                                           std::vector<std::pair<int, int>>* pairs = nullptr);
+class LineTracker {
+ public:
+  static constexpr double kNoStamp = std::numeric_limits<double>::quiet_NaN();
+  explicit LineTracker(const LineTrackerOptions& options = {});
+
+  // Tracks into this frame's segments (described and oriented, as detect_line_features gives
+  // them; descriptors optional) and starts tracks for the unmatched ones. Returns the track id
+  // of every segment of `current`, in order. `stamp` (seconds) scales the constant-velocity
+  // prediction when frames are not evenly spaced.
+  std::vector<int64_t> track(const LineFeatures& current, double stamp = kNoStamp,
+                             LineTrackingStats* stats = nullptr);
+  void reset();
+  int num_tracks() const { return static_cast<int>(tracks_.size()); }
+
+ private:
+  struct Track {
+    int64_t id = 0;
+    LineSegment segment;  // where it was last seen (oriented)
+    cv::Mat descriptor;   // its LBD row then, or empty
+    double seen_at = 0.0;
+    // Image motion per unit of time: the shift of the line along its normal at the midpoint and
+    // the turn of its direction; unknown until seen twice.
+    bool has_motion = false;
+    Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+    double turn = 0.0;
+    int missed = 0;  // frames in a row without a match
+  };
+  // Where track t lies at time `now`.
+  static LineSegment predict(const Track& t, double now);
+
+  LineTrackerOptions options_;
+  std::vector<Track> tracks_;
+  int64_t next_id_ = 0;
+  // The tracker's clock: the frames' stamps, or one unit per frame without them.
+  double now_ = 0.0;
+  bool started_ = false;
+};
 
 }  // namespace hybrid_vo

@@ -28,18 +28,16 @@ enum class PointFeatureSource {
 };
 
 struct VisualOdometryOptions {
-  VisualOdometryOptions();  // the video presets of the front end (ORB, FLD)
+  VisualOdometryOptions();  // the video presets of the front end (ORB, FLD) and of low texture
 
   PointFeatureSource point_source = PointFeatureSource::kTracking;
   bool use_lines = true;
   FrontendOptions features;   // descriptors for points (kDescriptors) and segments
   KltTrackerOptions klt;
-  // Segments matched to the keyframe by tracking (prediction from the point matches, local
-  // search, LBD where ambiguous, full LBD matching for the rest); false: full LBD matching only.
-  // Off by default: on the shared KITTI excerpt through the node it cost 1.9 AUC@10 and 0.7
-  // deg/100 m of rotation drift (tracked segments are more, but less often on a VP or junction).
-  bool track_lines = false;
-  LineTrackingOptions line_tracking;
+  // Segments tracked frame to frame by their own geometry (LineTracker) and paired with the
+  // keyframe's by track id; false: the keyframe's segments matched by LBD in every frame.
+  bool track_lines = true;
+  LineTrackerOptions line_tracking;
   // The segments and the stereo matching on a second thread, beside the points and the
   // estimator. The results do not depend on it.
   bool concurrent = true;
@@ -61,6 +59,15 @@ struct VisualOdometryOptions {
   AffineTrackingOptions stereo_track_refinement;
   bool use_vp_tracker = true;
   VpTrackerOptions vp_tracker;
+  // Orientation anchoring (VpTracker::anchor): each frame's orientation, predicted by the pair's
+  // rotation, is corrected by the confident VP tracks it sees. The prediction's uncertainty grows
+  // per pair by the estimator's rotation covariance, times rotation_covariance_scale, plus
+  // rotation_drift_floor_deg per axis. The estimator's covariance tells a pair whose points
+  // barely separate rotation from translation (white panels seen from 2 m: 0.08 deg) from a well
+  // conditioned one (KITTI: 0.003 deg), where VPs, with their degree of noise, must not move it.
+  bool anchor_orientation = true;
+  double rotation_covariance_scale = 4.0;
+  double rotation_drift_floor_deg = 0.005;
 };
 
 // Externally detected features of a frame (e.g. from a learned front end); ids link them across
@@ -119,6 +126,7 @@ struct VisualOdometryResult {
   std::vector<int> vp_track_ids; // per VP match of the pair: the track of its prior, or -1
   // Per VP the pose accepted, as seen in the current image: its track and the tracker's gate.
   std::vector<VpAssociation> vp_associations;
+  AnchoredOrientation anchoring;  // with anchor_orientation: how the tracks corrected this frame
   int num_point_matches = 0, num_line_matches = 0;
   LineTrackingStats line_tracking;  // with track_lines
   // Wall clock: image to matches, VPs + estimator, the whole frame; and per stage.
@@ -151,10 +159,12 @@ class VisualOdometry {
     std::map<int64_t, Eigen::Vector3d> points3d;        // id -> stereo point (metres, camera)
     ImageFeatures features;                             // segments (and descriptor points)
     std::map<int64_t, LineSegment> external_lines;      // id -> segment
+    std::map<int64_t, LineSegment> tracked_lines;       // LineTracker id -> segment
     bool points_undistorted = false, lines_undistorted = false;
     CameraModel camera;
     cv::Mat image;  // grey, kept for the scale's track refinement (stereo input only)
     Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d R_wc_covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   };
 
@@ -166,7 +176,8 @@ class VisualOdometry {
                                                const std::map<int64_t, Eigen::Vector2d>& points) const;
   void make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
                      const std::map<int64_t, Eigen::Vector2d>& points,
-                     std::map<int64_t, Eigen::Vector3d> points3d, ImageFeatures features);
+                     std::map<int64_t, Eigen::Vector3d> points3d, ImageFeatures features,
+                     const std::vector<int64_t>& line_ids);
 
   // The scale's observations of an estimated pair: the keyframe's stereo points among the
   // pose's point inliers, seen again (with their current disparities when known).
@@ -189,11 +200,13 @@ class VisualOdometry {
   VisualOdometryOptions options_;
   std::unique_ptr<WorkerThread> worker_;
   KltTracker klt_;
+  LineTracker line_tracker_;
   VpTracker vp_tracker_;
   // Kept across reset(): the offset belongs to the rig, not to the trajectory.
   DisparityOffsetFilter offset_filter_;
   Keyframe keyframe_;
   Eigen::Matrix3d R_wc_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R_wc_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   double last_stamp_ = -1e300;
   bool tracker_seeded_ = false;

@@ -18,6 +18,11 @@ struct VpDetectionOptions {
   double min_segment_length_px = 15.0;  // shorter segments say little about their direction
   int max_vps = 4;
   int min_inliers = 6;                  // supporting segments (matches) of a VP
+  // Or fewer, but long: a VP's evidence is how much of the image its segments span, not their
+  // number (a white room has a handful of long edges). A VP with at least min_long_inliers
+  // segments whose lengths sum to min_support_px per image is kept too; 0 disables.
+  int min_long_inliers = 0;
+  double min_support_px = 0.0;
   int max_iterations = 1000;            // RANSAC draws per VP; fewer when the support is clear
   double confidence = 0.999;
   double merge_angle_deg = 2.0;         // near-duplicate VPs (in every image) are merged

@@ -62,6 +62,17 @@ struct VpTrack {
   double sigma_deg() const;
 };
 
+// The camera's orientation after anchor(): the odometry's orientation corrected by the directions
+// of the confident tracks seen again.
+struct AnchoredOrientation {
+  Eigen::Matrix3d R_world_from_camera = Eigen::Matrix3d::Identity();
+  // Of the orientation's left increment in the odometry frame (rad^2).
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  int anchors = 0;   // observations that corrected it
+  int rejected = 0;  // observations of a confident track that failed the chi-square test
+  double correction_deg = 0.0;
+};
+
 // Per observation of an update: its track (or -1), and the gate's verdict.
 struct VpAssociation {
   int track_id = -1;
@@ -108,6 +119,21 @@ class VpTracker {
   // gives only invalid priors.
   std::vector<VpPrior> priors(const Eigen::Matrix3d& R_world_from_camera1,
                               const std::vector<VpMatch>& matches) const;
+
+  // Orientation anchoring (issue 30): a VP is a fixed scene direction, so the confident tracks are
+  // an absolute reference for the camera's rotation, which the frame-to-frame odometry can only
+  // accumulate. Given the odometry's orientation of the current camera and its uncertainty (the
+  // covariance of a left increment in the odometry frame, grown by every pair since it was last
+  // anchored), each observation associated with a confident track corrects it by a Kalman update
+  // on the rotation, under the track's and the observation's covariances. An observation whose
+  // innovation fails the chi-square gate is left out: where the odometry is still certain, a VP
+  // that disagrees is the one that is wrong; where it has drifted, its grown covariance lets the
+  // tracks pull it back. Observations are taken most certain first. The tracks are unchanged
+  // (update them with the anchored orientation afterwards). An invalid rotation or covariance
+  // returns the input unchanged.
+  AnchoredOrientation anchor(const Eigen::Matrix3d& R_world_from_camera,
+                             const Eigen::Matrix3d& covariance,
+                             const std::vector<VpObservation>& observations) const;
 
   // Drops every track, e.g. when time goes backwards; ids keep increasing.
   void reset() { tracks_.clear(); }
