@@ -278,7 +278,9 @@ int run(int argc, char** argv) {
       estimate.push_back(odometry.back());
       truth.push_back(g);
       const int reference = frame_of(r.reference_stamp);
-      if (i > 0 && reference >= 0 && reference < i) {
+      // A frame skipped for too little parallax is no pair, as hybrid_vo_eval_trajectory skips
+      // the node's STATUS_SKIPPED; a failure to estimate counts as an error of 180 degrees.
+      if (i > 0 && reference >= 0 && reference < i && r.status != VoStatus::kLowParallax) {
         double error = 180.0;
         if (r.status == VoStatus::kOk) {
           const datasets::KittiPose& a = gt[reference];
