@@ -129,21 +129,25 @@ void biased_walk(int n, double rate, Bias bias_deg, Trajectory* truth, Trajector
   }
 }
 
-// A rotation bias of b degrees per frame at 30 Hz: b per pair, 30 b over 1 s, b (N - 1) at the
+// A rotation bias of b degrees per frame at 25 Hz: b per pair, 25 b over 1 s, b (N - 1) at the
 // last frame and at most; the truth against itself gives zeros.
 TEST(Trajectory, RotationMeasuresOfAConstantBias) {
   const double b = 0.05;
   const int n = 100;
   Trajectory truth, estimate;
-  biased_walk(n, 30.0, [&](int k) { return b * k; }, &truth, &estimate);
+  biased_walk(n, 25.0, [&](int k) { return b * k; }, &truth, &estimate);
   const TrajectoryErrors e = compare_trajectories(estimate, truth, true, 1e-3);
   EXPECT_EQ(e.pairs, n - 1);
   EXPECT_NEAR(e.rot_pair_median_deg, b, 1e-9);
   EXPECT_EQ(e.window_s, 1.0);
-  // Every pose up to 1 s before the last starts a window.
-  EXPECT_EQ(e.rot_window_err_deg.size(), static_cast<size_t>(n - 30));
-  for (const double w : e.rot_window_err_deg) EXPECT_NEAR(w, 30 * b, 1e-9);
-  EXPECT_NEAR(e.rot_window_median_deg, 30 * b, 1e-9);
+  // Every pose up to 1 s before the last starts a window; so do the next two, whose windows end
+  // at the last pose 1 and 2 frames short of a second (within 10 % of it).
+  ASSERT_EQ(e.rot_window_err_deg.size(), static_cast<size_t>(n - 25 + 2));
+  for (size_t i = 0; i < e.rot_window_err_deg.size(); ++i)
+    EXPECT_NEAR(e.rot_window_err_deg[i], (i < n - 25 ? 25 : n - 1 - static_cast<int>(i)) * b,
+                1e-9)
+        << i;
+  EXPECT_NEAR(e.rot_window_median_deg, 25 * b, 1e-9);
   EXPECT_NEAR(e.orientation_last_deg, (n - 1) * b, 1e-9);
   EXPECT_NEAR(e.orientation_max_deg, (n - 1) * b, 1e-9);
   // Rotations only: the centres agree, so the translation direction errors are the bias seen
@@ -151,12 +155,13 @@ TEST(Trajectory, RotationMeasuresOfAConstantBias) {
   EXPECT_GT(e.dir_median_deg, 0.0);
   EXPECT_LT(e.dir_median_deg, 10.0);
 
-  // Another window length: half a second is 15 frames.
-  const TrajectoryErrors half = compare_trajectories(estimate, truth, true, 1e-3, nullptr, 0.5);
-  EXPECT_EQ(half.window_s, 0.5);
-  EXPECT_EQ(half.rot_window_err_deg.size(), static_cast<size_t>(n - 15));
-  EXPECT_NEAR(half.rot_window_median_deg, 15 * b, 1e-9);
-  EXPECT_NEAR(half.rot_pair_median_deg, b, 1e-9);
+  // Another window length: 0.6 s is 15 frames.
+  const TrajectoryErrors short_window =
+      compare_trajectories(estimate, truth, true, 1e-3, nullptr, 0.6);
+  EXPECT_EQ(short_window.window_s, 0.6);
+  EXPECT_EQ(short_window.rot_window_err_deg.size(), static_cast<size_t>(n - 15 + 1));
+  EXPECT_NEAR(short_window.rot_window_median_deg, 15 * b, 1e-9);
+  EXPECT_NEAR(short_window.rot_pair_median_deg, b, 1e-9);
 
   const TrajectoryErrors same = compare_trajectories(truth, truth, true, 1e-3);
   EXPECT_NEAR(same.rot_pair_median_deg, 0.0, 1e-9);
@@ -166,22 +171,22 @@ TEST(Trajectory, RotationMeasuresOfAConstantBias) {
   EXPECT_NEAR(same.dir_median_deg, 0.0, 1e-6);
 }
 
-// A bias that grows for 40 frames and shrinks back for 20 (10 Hz): the orientation is worst
-// at frame 40 (40 b), 20 b off at the end; over 1 s windows it is 10 b off, except where the
-// window holds the turn of the bias.
+// A bias that grows for 40 frames and shrinks back for 20 (8 Hz): the orientation is worst at
+// frame 40 (40 b), 20 b off at the end; over 1 s windows it is 8 b off, except where the window
+// holds the turn of the bias.
 TEST(Trajectory, OrientationErrorPeaksWhereTheBiasTurns) {
   const double b = 0.1;
   Trajectory truth, estimate;
-  biased_walk(61, 10.0, [&](int k) { return k <= 40 ? b * k : b * (80 - k); }, &truth,
+  biased_walk(61, 8.0, [&](int k) { return k <= 40 ? b * k : b * (80 - k); }, &truth,
               &estimate);
   const TrajectoryErrors e = compare_trajectories(estimate, truth, true, 1e-3);
   EXPECT_NEAR(e.orientation_max_deg, 40 * b, 1e-9);
   EXPECT_NEAR(e.orientation_last_deg, 20 * b, 1e-9);
   EXPECT_NEAR(e.rot_pair_median_deg, b, 1e-9);
-  ASSERT_EQ(e.rot_window_err_deg.size(), 51u);
-  EXPECT_NEAR(e.rot_window_err_deg[0], 10 * b, 1e-9);
-  EXPECT_NEAR(e.rot_window_err_deg[35], 0.0, 1e-9);  // 5 frames up, 5 down
-  EXPECT_NEAR(e.rot_window_median_deg, 10 * b, 1e-9);
+  ASSERT_EQ(e.rot_window_err_deg.size(), 53u);
+  EXPECT_NEAR(e.rot_window_err_deg[0], 8 * b, 1e-9);
+  EXPECT_NEAR(e.rot_window_err_deg[36], 0.0, 1e-9);  // 4 frames up, 4 down
+  EXPECT_NEAR(e.rot_window_median_deg, 8 * b, 1e-9);
 }
 
 // The translation direction error per pair: an estimate that moves 10 degrees off the true
@@ -208,19 +213,22 @@ TEST(Trajectory, DirectionErrorOfATurnedPath) {
 TEST(Trajectory, RotationMeasuresEdgeCases) {
   const double b = 0.05;
   Trajectory truth, estimate;
-  biased_walk(20, 30.0, [&](int k) { return b * k; }, &truth, &estimate);  // 0.63 s
+  biased_walk(20, 25.0, [&](int k) { return b * k; }, &truth, &estimate);  // 0.76 s
   const TrajectoryErrors short_run = compare_trajectories(estimate, truth, true, 1e-3);
   EXPECT_TRUE(short_run.rot_window_err_deg.empty());
   EXPECT_TRUE(std::isnan(short_run.rot_window_median_deg));
   EXPECT_NEAR(short_run.rot_pair_median_deg, b, 1e-9);
   EXPECT_NEAR(short_run.orientation_last_deg, 19 * b, 1e-9);
-  // 10 Hz, the last pose 0.93 s after the first: more than half a frame short of 1 s, no window.
+  // 10 Hz, the last pose 0.88 s after the first: more than 10 % short of 1 s, no window; at
+  // 0.92 s it ends the first one.
   Trajectory t10, e10;
   biased_walk(11, 10.0, [&](int k) { return b * k; }, &t10, &e10);
-  t10.back().stamp = e10.back().stamp = t10[0].stamp + 0.93;
+  t10.back().stamp = e10.back().stamp = t10[0].stamp + 0.88;
   EXPECT_TRUE(compare_trajectories(e10, t10, true, 1e-3).rot_window_err_deg.empty());
-  t10.back().stamp = e10.back().stamp = t10[0].stamp + 1.0;
-  EXPECT_EQ(compare_trajectories(e10, t10, true, 1e-3).rot_window_err_deg.size(), 1u);
+  t10.back().stamp = e10.back().stamp = t10[0].stamp + 0.92;
+  const TrajectoryErrors one_window = compare_trajectories(e10, t10, true, 1e-3);
+  ASSERT_EQ(one_window.rot_window_err_deg.size(), 1u);
+  EXPECT_NEAR(one_window.rot_window_err_deg[0], 10 * b, 1e-9);
 
   const std::vector<PosePair> poses = match_poses(estimate, truth, 1e-3);
   ASSERT_EQ(poses.size(), 20u);
@@ -238,14 +246,14 @@ TEST(Trajectory, RotationMeasuresEdgeCases) {
   // A pose that is not finite, in the estimate or in the truth, is left out; the measures stay
   // finite and those that do not depend on it unchanged.
   Trajectory long_truth, long_estimate;
-  biased_walk(100, 30.0, [&](int k) { return b * k; }, &long_truth, &long_estimate);
+  biased_walk(100, 25.0, [&](int k) { return b * k; }, &long_truth, &long_estimate);
   long_estimate[40].R(0, 1) = std::nan("");
   long_truth[60].c.z() = std::nan("");
   EXPECT_EQ(match_poses(long_estimate, long_truth, 1e-3).size(), 98u);
   const TrajectoryErrors holes = compare_trajectories(long_estimate, long_truth, true, 1e-3);
   EXPECT_EQ(holes.pairs, 97);
   EXPECT_NEAR(holes.rot_pair_median_deg, b, 1e-9);
-  EXPECT_NEAR(holes.rot_window_median_deg, 30 * b, 1e-9);
+  EXPECT_NEAR(holes.rot_window_median_deg, 25 * b, 1e-9);
   EXPECT_NEAR(holes.orientation_last_deg, 99 * b, 1e-9);
   EXPECT_NEAR(holes.orientation_max_deg, 99 * b, 1e-9);
   EXPECT_TRUE(std::isfinite(holes.dir_median_deg));

@@ -41,9 +41,8 @@ std::vector<PosePair> match_poses(const Trajectory& estimate, const Trajectory& 
                                   double tolerance);
 
 // Rotation error over windows of `window_s` seconds: for each pose i, the pose j whose stamp is
-// nearest to stamp_i + window_s, skipped unless it is within half the median spacing of the
-// stamps and within 10 % of the window; the error of the relative rotation i -> j is the angle
-// of R_est_rel^T R_gt_rel, in degrees. Drift accumulates over the window, so a constant rotation
+// nearest to stamp_i + window_s, skipped unless it is within 10 % of the window; the error of
+// the relative rotation i -> j is the angle of R_est_rel^T R_gt_rel, in degrees. Drift accumulates over the window, so a constant rotation
 // bias of b degrees per frame gives b times the frames per window. Empty when the poses span
 // less than a window or window_s is not a positive number.
 std::vector<double> window_rotation_errors_deg(const std::vector<PosePair>& poses,
