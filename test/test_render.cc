@@ -1,6 +1,7 @@
 // The synthetic sequence renderer: determinism, geometry (depth, painted corners, motion and
 // stereo consistent with the ground truth), image content that real detectors find (corners,
-// long segments through the Manhattan VPs), the walk, and option checking.
+// long segments through the Manhattan VPs), the walk, option checking, and the low-texture
+// variant (plain surfaces: only edges, noise elsewhere, few trackable corners).
 #include <algorithm>
 #include <array>
 #include <cmath>
