@@ -230,4 +230,58 @@ TEST(EvalTrajectoryCli, MissingBag) {
                "/no/run.bag");
 }
 
+// The value of "key=" on the summary line; NaN when absent.
+double summary_value(const std::string& output, const std::string& key) {
+  const size_t line = output.rfind("summary:");
+  if (line == std::string::npos) return std::nan("");
+  const size_t at = output.find(" " + key + "=", line);
+  return at == std::string::npos ? std::nan("") : std::atof(output.c_str() + at + key.size() + 2);
+}
+
+// Two TUM files: a camera moving along x at 25 Hz, and an estimate that turns 0.1 degrees per
+// frame too many about z. The rotation measures read 0.1 per pair, 2.5 over 1 s (25 frames), 6
+// at the last frame (60 frames) and at most; seen from camera i the path is i * 0.1 degrees
+// off, so the median translation direction error is that of the middle pair, 3.
+TEST(EvalTrajectoryCli, TumRotationMeasures) {
+  const std::string dir = testing::TempDir();
+  const std::string truth = dir + "/eval_trajectory_truth.txt";
+  const std::string estimate = dir + "/eval_trajectory_estimate.txt";
+  {
+    std::ofstream t(truth), e(estimate);
+    for (int k = 0; k <= 60; ++k) {
+      const double stamp = 10.0 + k / 25.0, half = 0.5 * 0.1 * k * M_PI / 180.0;
+      char line[256];
+      std::snprintf(line, sizeof(line), "%.6f %.3f 0 0 0 0 0 1\n", stamp, 0.1 * k);
+      t << line;
+      std::snprintf(line, sizeof(line), "%.6f %.3f 0 0 0 0 %.12f %.12f\n", stamp, 0.1 * k,
+                    std::sin(half), std::cos(half));
+      e << line;
+    }
+  }
+  const Outcome o = run("hybrid_vo_eval_trajectory", "--tum " + estimate + " " + truth);
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  // 36 windows of 1 s, and 2 ending at the last pose within 10 % of a second.
+  EXPECT_NE(o.output.find("# rotation error (deg): median 0.100 per pair (60 pairs of "
+                          "consecutive poses), 2.500 over 1 s windows (38)"),
+            std::string::npos)
+      << o.output;
+  EXPECT_NEAR(summary_value(o.output, "pairs"), 60.0, 1e-9) << o.output;
+  EXPECT_NEAR(summary_value(o.output, "rot_pair_deg"), 0.1, 1e-3) << o.output;
+  EXPECT_NEAR(summary_value(o.output, "rot_window_deg"), 2.5, 1e-3) << o.output;
+  EXPECT_NEAR(summary_value(o.output, "window_s"), 1.0, 1e-9) << o.output;
+  EXPECT_NEAR(summary_value(o.output, "orient_last_deg"), 6.0, 1e-3) << o.output;
+  EXPECT_NEAR(summary_value(o.output, "orient_max_deg"), 6.0, 1e-3) << o.output;
+  EXPECT_NEAR(summary_value(o.output, "dir_deg"), 3.0, 1e-3) << o.output;
+  // Windows of 0.6 s: 15 frames.
+  const Outcome shorter =
+      run("hybrid_vo_eval_trajectory", "--tum " + estimate + " " + truth + " --window 0.6");
+  ASSERT_EQ(shorter.exit_code, 0) << shorter.output;
+  EXPECT_NEAR(summary_value(shorter.output, "rot_window_deg"), 1.5, 1e-3) << shorter.output;
+  EXPECT_NEAR(summary_value(shorter.output, "window_s"), 0.6, 1e-9) << shorter.output;
+  for (const char* bad : {"0", "-1", "nan", "1s"})
+    expect_error(run("hybrid_vo_eval_trajectory",
+                     "--tum " + estimate + " " + truth + " --window " + bad),
+                 "--window: expected a positive number of seconds");
+}
+
 }  // namespace

@@ -33,6 +33,8 @@
 #include "hybrid_vo/conversion/bag_writing.h"
 #include "hybrid_vo/conversion/kitti_to_bag.h"
 #include "hybrid_vo/conversion/lamar_to_bag.h"
+#include "hybrid_vo/datasets/kitti.h"
+#include "hybrid_vo/datasets/readers.h"
 #include "hybrid_vo/render/sequence.h"
 
 namespace hybrid_vo {
@@ -406,6 +408,83 @@ TEST(KittiToBag, RealData) {
   options.stereo = true;
   EXPECT_FALSE(convert_kitti(options, &error));
   EXPECT_TRUE(contains(error, "image_1: no such directory"));
+}
+
+// hybrid_vo_render_sequence --kitti-dir: the rendered sequence in the KITTI layout reads back
+// through the KITTI readers as rendered (poses, intrinsics, baseline, times, images), and
+// hybrid_vo_kitti_to_bag turns it into the bag the renderer writes itself (same stamps, images
+// and ground truth).
+TEST(RenderSequence, KittiDirRoundTripsThroughTheReadersAndTheConverter) {
+  TempDir dir("test_convert");
+  const std::vector<std::string> args = {
+      "--kitti-dir", dir.path().string(), "--kitti-name", "lowtex", "--out",
+      (dir.path() / "rendered.bag").string(), "--frames", "4", "--width", "96", "--height", "72",
+      "--supersampling", "1", "--stereo", "--texture", "plain"};
+  std::string command = std::string(HYBRID_VO_BIN_DIR) + "/hybrid_vo_render_sequence";
+  for (const std::string& a : args) command += " " + a;
+  std::string output;
+  ASSERT_EQ(run(command, &output), 0) << output;
+  EXPECT_TRUE(contains(output, "rendered 4 frames (stereo, 96x72, corridor, plain, 10 Hz)"));
+  render::SequenceOptions options;
+  ASSERT_EQ(render::parse_sequence_args(args, &options), "");
+  const render::Sequence seq = render::make_sequence(options);
+
+  const fs::path sequence_dir = dir.path() / "sequences" / "lowtex";
+  datasets::Sequence read;
+  std::string error;
+  ASSERT_TRUE(datasets::read_kitti(sequence_dir.string(), &read, &error)) << error;
+  ASSERT_EQ(read.size(), 4);
+  datasets::KittiCalibration calibration;
+  ASSERT_TRUE(datasets::read_kitti_calibration((sequence_dir / "calib.txt").string(),
+                                               &calibration, &error))
+      << error;
+  EXPECT_NEAR(calibration.baseline(), options.baseline, 1e-12);
+  for (int i = 0; i < 4; ++i) {
+    const datasets::Frame& frame = read.frames[i];
+    EXPECT_NEAR(frame.timestamp, 0.1 * i, 1e-12);
+    EXPECT_LT((frame.R_wc - render::frame_pose(seq, i).R_world_from_camera).norm(), 1e-11);
+    EXPECT_LT((frame.c_w - render::frame_pose(seq, i).centre).norm(), 1e-11);
+    const PinholeCamera& camera = frame.camera.pinhole;
+    EXPECT_NEAR(camera.fx, seq.camera.fx, 1e-9);
+    EXPECT_NEAR(camera.fy, seq.camera.fy, 1e-9);
+    EXPECT_NEAR(camera.cx, seq.camera.cx, 1e-9);
+    EXPECT_NEAR(camera.cy, seq.camera.cy, 1e-9);
+    EXPECT_EQ(camera.width, 96);
+    EXPECT_EQ(camera.height, 72);
+    EXPECT_TRUE(same_image(cv::imread(frame.image_path, cv::IMREAD_UNCHANGED),
+                           render::render_frame(seq, i).image));
+    EXPECT_TRUE(same_image(
+        cv::imread(datasets::kitti_image_path(sequence_dir.string(), 1, i), cv::IMREAD_UNCHANGED),
+        render::render_frame(seq, i, true).image));
+  }
+
+  KittiBagOptions convert;
+  convert.sequence_dir = sequence_dir.string();
+  convert.out_bag = (dir.path() / "converted.bag").string();
+  convert.stereo = true;
+  ASSERT_TRUE(convert_kitti(convert, &error)) << error;
+  const BagData rendered = read_bag((dir.path() / "rendered.bag").string());
+  const BagData converted = read_bag(convert.out_bag);
+  for (const std::string topic : {"/camera/left/image_raw", "/camera/right/image_raw"}) {
+    ASSERT_EQ(converted.images.at(topic).size(), 4u) << topic;
+    for (int i = 0; i < 4; ++i) {
+      const sensor_msgs::Image& a = rendered.images.at(topic)[i];
+      const sensor_msgs::Image& b = converted.images.at(topic)[i];
+      EXPECT_EQ(a.header.stamp, b.header.stamp) << topic << " " << i;
+      EXPECT_TRUE(same_image(mono8(a), mono8(b))) << topic << " " << i;
+    }
+  }
+  ASSERT_EQ(converted.ground_truth.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(converted.ground_truth[i].header.stamp, rendered.ground_truth[i].header.stamp);
+    expect_pose(converted.ground_truth[i].pose, render::frame_pose(seq, i), 1e-9);
+  }
+  EXPECT_NEAR(converted.infos.at("/camera/right/camera_info")[0].P[3],
+              rendered.infos.at("/camera/right/camera_info")[0].P[3], 1e-9);
+
+  // A second run never mixes its frames into the first one's.
+  EXPECT_EQ(run(command, &output), 1) << output;
+  EXPECT_TRUE(contains(output, "already exists")) << output;
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -24,6 +24,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "file_test_utils.h"
+#include "hybrid_vo/datasets/kitti.h"
+#include "hybrid_vo/datasets/kitti_writer.h"
 #include "hybrid_vo/datasets/point_subset.h"
 #include "hybrid_vo/datasets/readers.h"
 #include "hybrid_vo/datasets/sequence.h"
@@ -414,6 +416,119 @@ TEST(Kitti, RootWithSeveralSequencesIsAmbiguous) {
   EXPECT_TRUE(read_kitti(fixture.sequence_dir().string(), &sequence, &error)) << error;
   EXPECT_FALSE(read_kitti((dir.path() / "nowhere").string(), &sequence, &error));
   EXPECT_TRUE(contains(error, "no such directory"));
+}
+
+// A stereo sequence written by KittiWriter reads back through read_kitti and the file readers:
+// intrinsics, baseline, times, poses and the images themselves.
+TEST(KittiWriter, RoundTripsThroughTheReaders) {
+  TempDir dir;
+  const PinholeCamera camera(420.5, 421.25, 159.5, 119.25);
+  const double baseline = 0.12;
+  const PoseChain chain(5);
+  std::vector<cv::Mat> left, right;
+  KittiWriter writer;
+  std::string error;
+  ASSERT_TRUE(writer.open(dir.path().string(), "lowtex", camera, baseline, &error)) << error;
+  for (int k = 0; k < 5; ++k) {
+    left.emplace_back(24, 32, CV_8U);
+    right.emplace_back(24, 32, CV_8U);
+    cv::randu(left.back(), 0, 256);
+    cv::randu(right.back(), 0, 256);
+    ASSERT_TRUE(writer.add_frame(0.1 * k, left[k], right[k], chain.R_wc[k], chain.c_w[k], &error))
+        << error;
+  }
+  ASSERT_TRUE(writer.close(&error)) << error;
+  EXPECT_EQ(writer.frames(), 5);
+  EXPECT_EQ(fs::path(writer.sequence_dir()), dir.path() / "sequences" / "lowtex");
+  EXPECT_EQ(fs::path(writer.poses_path()), dir.path() / "poses" / "lowtex.txt");
+
+  KittiCalibration calibration;
+  ASSERT_TRUE(read_kitti_calibration(writer.sequence_dir() + "/calib.txt", &calibration, &error))
+      << error;
+  for (const KittiProjection* P : {&calibration.P0, &calibration.P1}) {
+    EXPECT_NEAR(P->camera.fx, camera.fx, 1e-9);
+    EXPECT_NEAR(P->camera.fy, camera.fy, 1e-9);
+    EXPECT_NEAR(P->camera.cx, camera.cx, 1e-9);
+    EXPECT_NEAR(P->camera.cy, camera.cy, 1e-9);
+  }
+  EXPECT_NEAR(calibration.baseline(), baseline, 1e-12);
+  EXPECT_EQ(count_kitti_images(writer.sequence_dir(), 0), 5);
+  EXPECT_EQ(count_kitti_images(writer.sequence_dir(), 1), 5);
+
+  Sequence sequence;
+  ASSERT_TRUE(read_kitti(dir.path().string(), &sequence, &error)) << error;
+  EXPECT_EQ(sequence.name, "lowtex");
+  ASSERT_EQ(sequence.size(), 5);
+  for (int k = 0; k < 5; ++k) {
+    const Frame& frame = sequence.frames[k];
+    EXPECT_NEAR(frame.timestamp, 0.1 * k, 1e-12);
+    EXPECT_LT((frame.R_wc - chain.R_wc[k]).norm(), 1e-11);
+    EXPECT_LT((frame.c_w - chain.c_w[k]).norm(), 1e-11);
+    EXPECT_EQ(frame.camera.pinhole.width, 32);
+    EXPECT_EQ(frame.camera.pinhole.height, 24);
+    EXPECT_EQ(cv::norm(cv::imread(frame.image_path, cv::IMREAD_UNCHANGED), left[k], cv::NORM_INF),
+              0.0);
+    EXPECT_EQ(cv::norm(cv::imread(kitti_image_path(writer.sequence_dir(), 1, k),
+                                  cv::IMREAD_UNCHANGED),
+                       right[k], cv::NORM_INF),
+              0.0);
+  }
+  expect_pose_near(relative_pose(sequence, 1, 2), chain.Rr, chain.tr, 1e-10);
+
+  // Mono: P0 only, no image_1.
+  KittiWriter mono;
+  ASSERT_TRUE(mono.open(dir.path().string(), "mono", camera, 0.0, &error)) << error;
+  ASSERT_TRUE(mono.add_frame(0.0, left[0], cv::Mat(), chain.R_wc[0], chain.c_w[0], &error))
+      << error;
+  ASSERT_TRUE(mono.close(&error)) << error;
+  ASSERT_TRUE(read_kitti_calibration(mono.sequence_dir() + "/calib.txt", &calibration, &error));
+  EXPECT_FALSE(calibration.P1.present());
+  EXPECT_EQ(count_kitti_images(mono.sequence_dir(), 1), -1);
+}
+
+TEST(KittiWriter, RefusesBadInputWithTheReason) {
+  TempDir dir;
+  const std::string root = dir.path().string();
+  const PinholeCamera camera(400, 400, 15.5, 11.5);
+  const cv::Mat image(24, 32, CV_8U, cv::Scalar(7));
+  const Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  std::string error;
+  KittiWriter w;
+  EXPECT_FALSE(w.open(root, "a", PinholeCamera(0, 400, 15.5, 11.5), 0.0, &error));
+  EXPECT_TRUE(contains(error, "invalid camera"));
+  EXPECT_FALSE(w.open(root, "a", camera, -0.1, &error));
+  EXPECT_TRUE(contains(error, "baseline"));
+  EXPECT_FALSE(w.open(root, "a/b", camera, 0.0, &error));
+  EXPECT_TRUE(contains(error, "not a sequence name"));
+  EXPECT_FALSE(w.open("/proc/no_such_root", "a", camera, 0.0, &error));
+  EXPECT_TRUE(contains(error, "cannot create"));
+  EXPECT_FALSE(w.add_frame(0.0, image, image, R, c, &error));
+  EXPECT_TRUE(contains(error, "not open"));
+
+  ASSERT_TRUE(w.open(root, "a", camera, 0.1, &error)) << error;
+  EXPECT_FALSE(w.add_frame(0.0, image, cv::Mat(), R, c, &error));
+  EXPECT_TRUE(contains(error, "frame 0: right image is not 8-bit grey"));
+  EXPECT_FALSE(w.add_frame(0.0, cv::Mat(24, 32, CV_16U), image, R, c, &error));
+  EXPECT_TRUE(contains(error, "left image is not 8-bit grey"));
+  EXPECT_FALSE(w.add_frame(0.0, image, image, R * std::nan(""), c, &error));
+  EXPECT_TRUE(contains(error, "the pose is not finite"));
+  ASSERT_TRUE(w.add_frame(0.0, image, image, R, c, &error)) << error;
+  EXPECT_FALSE(w.add_frame(0.0, image, image, R, c, &error));
+  EXPECT_TRUE(contains(error, "frame 1: time 0.000000000000e+00 does not increase"));
+  EXPECT_FALSE(w.add_frame(0.1, cv::Mat(12, 16, CV_8U), cv::Mat(12, 16, CV_8U), R, c, &error));
+  EXPECT_TRUE(contains(error, "left image is 16x12, not 32x24 as before"));
+  ASSERT_TRUE(w.close(&error)) << error;
+  EXPECT_FALSE(w.add_frame(0.2, image, image, R, c, &error));
+  EXPECT_TRUE(contains(error, "not open"));
+  KittiWriter empty;
+  ASSERT_TRUE(empty.open(root, "empty", camera, 0.0, &error)) << error;
+  EXPECT_FALSE(empty.close(&error));
+  EXPECT_TRUE(contains(error, "no frames"));
+  // An existing sequence is never mixed with a new one.
+  KittiWriter again;
+  EXPECT_FALSE(again.open(root, "a", camera, 0.0, &error));
+  EXPECT_TRUE(contains(error, "already exists"));
 }
 
 // ------------------------------------------------------------------------------------------------

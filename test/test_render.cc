@@ -1,6 +1,7 @@
 // The synthetic sequence renderer: determinism, geometry (depth, painted corners, motion and
 // stereo consistent with the ground truth), image content that real detectors find (corners,
-// long segments through the Manhattan VPs), the walk, and option checking.
+// long segments through the Manhattan VPs), the walk, option checking, and the low-texture
+// variant (plain surfaces: only edges, noise elsewhere, few trackable corners).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -452,6 +453,254 @@ TEST_F(RenderTest, WalkTurnsAndStaysInside) {
   EXPECT_GT(walk.total_turn_deg, 45.0);
 }
 
+// ------------------------------------------------------------------------------------------------
+// The low-texture variant (--texture plain): the same corridor and walk with plain surfaces.
+
+class PlainRenderTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    SequenceOptions options;
+    options.out_bag = "unused.bag";
+    options.frames = 60;
+    options.texture = TextureStyle::kPlain;
+    plain_ = new Sequence(make_sequence(options));
+    options.texture = TextureStyle::kTextured;
+    textured_ = new Sequence(make_sequence(options));
+  }
+  static void TearDownTestSuite() {
+    delete plain_;
+    delete textured_;
+    plain_ = textured_ = nullptr;
+  }
+  static const Sequence& plain() { return *plain_; }
+  static const Sequence& textured() { return *textured_; }
+  static Sequence* plain_;
+  static Sequence* textured_;
+};
+
+Sequence* PlainRenderTest::plain_ = nullptr;
+Sequence* PlainRenderTest::textured_ = nullptr;
+
+// The albedo (level-0 texel, 0..255) each pixel centre sees, from the depth and quad buffers.
+cv::Mat albedo_image(const Sequence& seq, const CameraPose& pose, const RenderedView& view) {
+  cv::Mat albedo(view.image.size(), CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y < albedo.rows; ++y)
+    for (int x = 0; x < albedo.cols; ++x) {
+      const int id = view.quad_id.at<int>(y, x);
+      if (id < 0) continue;
+      const Quad& q = seq.scene.quads[id];
+      const cv::Mat& texels = q.texture.levels[0];
+      const Eigen::Vector2d uv =
+          q.local(back_project(seq.camera, pose, x, y, view.depth.at<float>(y, x)));
+      const double tpm = q.texture.texels_per_metre;
+      const int c = std::clamp(static_cast<int>(std::floor(uv.x() * tpm)), 0, texels.cols - 1);
+      const int r = std::clamp(static_cast<int>(std::floor(uv.y() * tpm)), 0, texels.rows - 1);
+      albedo.at<uchar>(y, x) = texels.at<uchar>(r, c);
+    }
+  return albedo;
+}
+
+// Pixels within `radius` of an edge: where the surface (quad) or its albedo changes.
+cv::Mat edge_mask(const RenderedView& view, const cv::Mat& albedo, int radius) {
+  cv::Mat edges(view.image.size(), CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y + 1 < edges.rows; ++y)
+    for (int x = 0; x + 1 < edges.cols; ++x) {
+      const int id = view.quad_id.at<int>(y, x);
+      const uchar a = albedo.at<uchar>(y, x);
+      if (view.quad_id.at<int>(y, x + 1) != id || view.quad_id.at<int>(y + 1, x) != id ||
+          albedo.at<uchar>(y, x + 1) != a || albedo.at<uchar>(y + 1, x) != a)
+        edges.at<uchar>(y, x) = 255;
+    }
+  cv::dilate(edges, edges, cv::getStructuringElement(cv::MORPH_RECT,
+                                                     cv::Size(2 * radius + 1, 2 * radius + 1)));
+  return edges;
+}
+
+// Gradient magnitude in grey levels per pixel (Sobel / 8).
+cv::Mat gradient(const cv::Mat& image) {
+  cv::Mat gx, gy, magnitude;
+  cv::Sobel(image, gx, CV_32F, 1, 0, 3, 1.0 / 8.0);
+  cv::Sobel(image, gy, CV_32F, 0, 1, 3, 1.0 / 8.0);
+  cv::magnitude(gx, gy, magnitude);
+  return magnitude;
+}
+
+std::vector<double> values_where(const cv::Mat& values, const cv::Mat& mask) {
+  std::vector<double> out;
+  for (int y = 2; y < values.rows - 2; ++y)
+    for (int x = 2; x < values.cols - 2; ++x)
+      if (mask.at<uchar>(y, x)) out.push_back(values.at<float>(y, x));
+  return out;
+}
+
+// Every texture is a few plain areas: almost no texel differs from its neighbours (the door
+// frames, floor joints and light panels are the exceptions), where the textured scene's differ
+// nearly everywhere.
+TEST_F(PlainRenderTest, SurfacesHaveNoTexture) {
+  auto changing_texels = [](const Scene& scene, SurfaceKind kind) {
+    double changing = 0.0, total = 0.0;
+    for (const Quad& q : scene.quads) {
+      if (q.kind != kind) continue;
+      const cv::Mat& t = q.texture.levels[0];
+      cv::Mat dx, dy;
+      cv::absdiff(t.colRange(1, t.cols), t.colRange(0, t.cols - 1), dx);
+      cv::absdiff(t.rowRange(1, t.rows), t.rowRange(0, t.rows - 1), dy);
+      changing += cv::countNonZero(dx) + cv::countNonZero(dy);
+      total += dx.total() + dy.total();
+    }
+    return changing / total;
+  };
+  for (const SurfaceKind kind :
+       {SurfaceKind::kFloor, SurfaceKind::kCeiling, SurfaceKind::kWall, SurfaceKind::kFurniture}) {
+    const double plain_fraction = changing_texels(plain().scene, kind);
+    const double textured_fraction = changing_texels(textured().scene, kind);
+    EXPECT_LT(plain_fraction, 0.005) << "kind " << static_cast<int>(kind);
+    EXPECT_GT(textured_fraction, 0.3) << "kind " << static_cast<int>(kind);
+  }
+}
+
+// The same corridor, lights, boxes and walk as the textured scene of the seed: only the
+// surfaces' look differs.
+TEST_F(PlainRenderTest, GeometryAndWalkAreTheTexturedScenes) {
+  const Scene& a = plain().scene;
+  const Scene& b = textured().scene;
+  ASSERT_EQ(a.quads.size(), b.quads.size());
+  for (size_t i = 0; i < a.quads.size(); ++i) {
+    EXPECT_EQ(a.quads[i].origin, b.quads[i].origin);
+    EXPECT_EQ(a.quads[i].normal, b.quads[i].normal);
+    EXPECT_EQ(a.quads[i].size_u, b.quads[i].size_u);
+    EXPECT_EQ(a.quads[i].size_v, b.quads[i].size_v);
+    EXPECT_EQ(a.quads[i].kind, b.quads[i].kind);
+    EXPECT_EQ(cv::norm(a.quads[i].lightmap, b.quads[i].lightmap, cv::NORM_INF), 0.0);
+  }
+  ASSERT_EQ(a.boxes.size(), b.boxes.size());
+  for (size_t i = 0; i < a.boxes.size(); ++i) EXPECT_EQ(a.boxes[i].min, b.boxes[i].min);
+  EXPECT_EQ(a.lights.size(), b.lights.size());
+  ASSERT_EQ(plain().trajectory.poses.size(), textured().trajectory.poses.size());
+  for (size_t i = 0; i < plain().trajectory.poses.size(); ++i)
+    EXPECT_EQ(plain().trajectory.poses[i].centre, textured().trajectory.poses[i].centre);
+  EXPECT_EQ(plain().scene.options.texture, TextureStyle::kPlain);
+  // A few plain door frames on the walls: their top corners are the landmarks.
+  EXPECT_GE(a.landmarks.size(), 6u);
+  EXPECT_LT(a.landmarks.size(), b.landmarks.size() / 2);
+}
+
+// Away from the edges (of the surfaces and of their albedo) a plain image is flat: with the
+// noise off its gradient is the lighting's (smooth, in 8-bit steps), and with the noise on it is
+// close to the noise's. Most of the image is such flat area. The textured image of the same pose
+// has little of it, and over the plain image's flat area its gradient fails the same check.
+// Edges are where the geometry says: visible where surfaces meet, and LSD's segments lie on
+// the edges of the surfaces and their albedo.
+TEST_F(PlainRenderTest, ImagesAreFlatAwayFromTheEdges) {
+  cv::Ptr<cv::LineSegmentDetector> lsd = cv::createLineSegmentDetector();
+  int long_segments = 0, on_edges = 0;
+  for (int frame : {0, 15, 30, 45}) {
+    const CameraPose& pose = plain().trajectory.poses[frame];
+    const RenderedView view = render_frame(plain(), frame);
+    RenderOptions quiet = plain().render;
+    quiet.noise_sigma = 0.0;
+    const cv::Mat clean = render_view(plain().scene, plain().camera, pose, quiet).image;
+    const cv::Mat edges = edge_mask(view, albedo_image(plain(), pose, view), 3);
+    cv::Mat flat;
+    cv::bitwise_not(edges, flat);
+    EXPECT_GT(cv::countNonZero(flat), 0.8 * flat.total()) << "frame " << frame;
+
+    cv::Mat noise;
+    cv::subtract(view.image, clean, noise, cv::noArray(), CV_32F);
+    const std::vector<double> lit = values_where(gradient(clean), flat);
+    const std::vector<double> noisy = values_where(gradient(view.image), flat);
+    const std::vector<double> noise_only = values_where(gradient(noise), flat);
+    EXPECT_LT(quantile(lit, 0.9), 1.5) << "frame " << frame;
+    EXPECT_LT(quantile(noisy, 0.5), 1.3 * quantile(noise_only, 0.5)) << "frame " << frame;
+    EXPECT_LT(quantile(noisy, 0.9), 1.5 * quantile(noise_only, 0.9)) << "frame " << frame;
+
+    const RenderedView textured_view = render_frame(textured(), frame);
+    const cv::Mat textured_edges =
+        edge_mask(textured_view, albedo_image(textured(), pose, textured_view), 3);
+    EXPECT_LT(cv::countNonZero(~textured_edges), 0.2 * flat.total()) << "frame " << frame;
+    // The plain criterion, on the textured image: its texture fails it.
+    EXPECT_GT(quantile(values_where(gradient(textured_view.image), flat), 0.9),
+              1.5 * quantile(noise_only, 0.9))
+        << "frame " << frame;
+
+    // Where two surfaces of different orientation meet, the lighting draws the edge: within
+    // 2 px of the crease the gradient is many times the noise's.
+    cv::Mat near_crease;
+    cv::dilate(gradient(clean), near_crease, cv::Mat::ones(5, 5, CV_8U));
+    std::vector<double> crease;
+    for (int y = 3; y + 3 < view.image.rows; ++y)
+      for (int x = 3; x + 3 < view.image.cols; ++x) {
+        const int id = view.quad_id.at<int>(y, x);
+        for (const cv::Point d : {cv::Point(1, 0), cv::Point(0, 1)}) {
+          const int other = view.quad_id.at<int>(y + d.y, x + d.x);
+          if (other != id && plain().scene.quads[other].normal != plain().scene.quads[id].normal)
+            crease.push_back(near_crease.at<float>(y, x));
+        }
+      }
+    EXPECT_GT(crease.size(), 1000u) << "frame " << frame;
+    EXPECT_GT(quantile(crease, 0.5), 10.0 * quantile(noise_only, 0.5)) << "frame " << frame;
+
+    std::vector<cv::Vec4f> segments;
+    lsd->detect(view.image, segments);
+    int frame_segments = 0, frame_on_edges = 0;
+    for (const cv::Vec4f& s : segments) {
+      if (std::hypot(s[2] - s[0], s[3] - s[1]) < 20.0) continue;
+      ++frame_segments;
+      bool on = true;
+      for (double t = 0.0; t <= 1.0; t += 0.1) {
+        const int x = static_cast<int>(std::lround(s[0] + t * (s[2] - s[0])));
+        const int y = static_cast<int>(std::lround(s[1] + t * (s[3] - s[1])));
+        on = on && edges.at<uchar>(std::clamp(y, 0, edges.rows - 1),
+                                   std::clamp(x, 0, edges.cols - 1));
+      }
+      frame_on_edges += on;
+    }
+    EXPECT_GE(frame_segments, 3) << "frame " << frame;
+    EXPECT_GE(frame_on_edges, 0.8 * frame_segments) << "frame " << frame;
+    long_segments += frame_segments;
+    on_edges += frame_on_edges;
+  }
+  EXPECT_GE(long_segments, 40);
+  EXPECT_GE(on_edges, 0.9 * long_segments);
+}
+
+// A point tracker finds a handful of corners that follow the motion (box, door and joint
+// corners); the textured corridor gives hundreds.
+TEST_F(PlainRenderTest, FewCornersFollowTheMotion) {
+  const PinholeCamera& cam = plain().camera;
+  auto tracked_with_the_motion = [&](const Sequence& seq, int frame) {
+    const CameraPose& pose1 = seq.trajectory.poses[frame];
+    const CameraPose& pose2 = seq.trajectory.poses[frame + 1];
+    const RenderedView v1 = render_frame(seq, frame), v2 = render_frame(seq, frame + 1);
+    std::vector<cv::Point2f> corners, tracked;
+    cv::goodFeaturesToTrack(v1.image, corners, 1000, 0.01, 8);
+    std::vector<uchar> status;
+    std::vector<float> error;
+    cv::calcOpticalFlowPyrLK(v1.image, v2.image, corners, tracked, status, error,
+                             cv::Size(21, 21), 3);
+    int good = 0;
+    for (size_t k = 0; k < corners.size(); ++k) {
+      if (!status[k]) continue;
+      const float z = v1.depth.at<float>(static_cast<int>(std::lround(corners[k].y)),
+                                         static_cast<int>(std::lround(corners[k].x)));
+      Eigen::Vector2d p2;
+      double z2 = 0.0;
+      if (!project(cam, pose2, back_project(cam, pose1, corners[k].x, corners[k].y, z), 2.0,
+                   &p2, &z2))
+        continue;
+      good += std::hypot(tracked[k].x - p2.x(), tracked[k].y - p2.y()) < 0.5;
+    }
+    return good;
+  };
+  for (int frame : {5, 25, 40}) {
+    const int plain_good = tracked_with_the_motion(plain(), frame);
+    const int textured_good = tracked_with_the_motion(textured(), frame);
+    EXPECT_LT(plain_good, 60) << "frame " << frame;
+    EXPECT_GT(textured_good, 100) << "frame " << frame;
+    EXPECT_LT(3 * plain_good, textured_good) << "frame " << frame;
+  }
+}
+
 TEST(RenderOptions, StampsAreExact) {
   EXPECT_EQ(frame_stamp_ns(0, 10.0), 1000000000ull);
   EXPECT_EQ(frame_stamp_ns(1, 10.0), 1100000000ull);
@@ -475,6 +724,22 @@ TEST(RenderOptions, ArgumentsAreParsedAndBadOnesRejected) {
   EXPECT_EQ(o.seed, 7u);
   EXPECT_EQ(o.scene, SceneType::kRoom);
   EXPECT_EQ(o.png_dir, "/tmp/p");
+  EXPECT_EQ(o.texture, TextureStyle::kTextured);
+  EXPECT_TRUE(o.kitti_dir.empty());
+
+  // The KITTI layout alone is an output too; the plain surfaces.
+  SequenceOptions kitti;
+  EXPECT_EQ(parse_sequence_args({"--kitti-dir", "/tmp/k", "--kitti-name", "lowtex", "--texture",
+                                 "plain"},
+                                &kitti),
+            "");
+  EXPECT_TRUE(kitti.out_bag.empty());
+  EXPECT_EQ(kitti.kitti_dir, "/tmp/k");
+  EXPECT_EQ(kitti.kitti_name, "lowtex");
+  EXPECT_EQ(kitti.texture, TextureStyle::kPlain);
+  SequenceOptions default_name;
+  EXPECT_EQ(parse_sequence_args({"--kitti-dir", "/tmp/k"}, &default_name), "");
+  EXPECT_EQ(default_name.kitti_name, "00");
 
   const std::vector<std::vector<std::string>> bad = {
       {},         // no --out
@@ -494,6 +759,11 @@ TEST(RenderOptions, ArgumentsAreParsedAndBadOnesRejected) {
       {"--out", "x.bag", "--supersampling", "0"},
       {"--out", "x.bag", "--compression", "zip"},
       {"--out", "x.bag", "--bogus"},
+      {"--out", "x.bag", "--texture", "wood"},
+      {"--kitti-dir", "/tmp/k", "--kitti-name", "a/b"},
+      {"--kitti-dir", "/tmp/k", "--kitti-name", ".."},
+      {"--kitti-dir", ""},
+      {"--kitti-name", "00"},  // no output
   };
   for (const auto& args : bad) {
     SequenceOptions options;

@@ -1,7 +1,9 @@
 // The trajectory tools the evaluation rests on: TUM files round trip, relative rotations follow
-// the relative-pose convention, and drift measures a known rotation bias.
+// the relative-pose convention, and drift and the rotation measures (per pair, over windows,
+// orientation against the first frame) measure a known rotation bias.
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -106,6 +108,156 @@ TEST(Trajectory, DriftMeasuresAConstantRotationBias) {
   EXPECT_NEAR(biased.drift_rot_deg_per_100m, 0.2, 1e-6);
   EXPECT_NEAR(biased.rpe_rot_deg, 0.01, 1e-9);
   for (const double e : biased.rot_err_deg) EXPECT_NEAR(e, 0.01, 1e-9);
+}
+
+// A hand-held camera at `rate` Hz turning about a tilted axis and moving forward, and an
+// estimate of it whose rotation gains bias_deg(k) degrees about a fixed world axis by frame k
+// (R_est_k = Q(bias_deg(k)) R_k): for every pair of frames i, j the relative rotation is then
+// off by |bias_deg(j) - bias_deg(i)| exactly, whatever the camera's own rotation.
+template <class Bias>
+void biased_walk(int n, double rate, Bias bias_deg, Trajectory* truth, Trajectory* estimate) {
+  const Eigen::Vector3d bias_axis = Eigen::Vector3d(0.3, 1.0, -0.2).normalized();
+  for (int k = 0; k < n; ++k) {
+    StampedPose g;
+    g.stamp = 50.0 + k / rate;
+    g.R = rotation(Eigen::Vector3d(0.1, 1.0, 0.3), 0.4 * k) * rotation(Eigen::Vector3d::UnitX(), 10.0);
+    g.c = Eigen::Vector3d(0.02 * k, 0.01 * std::sin(0.3 * k), 0.05 * k);
+    truth->push_back(g);
+    StampedPose e = g;
+    e.R = rotation(bias_axis, bias_deg(k)) * g.R;
+    estimate->push_back(e);
+  }
+}
+
+// A rotation bias of b degrees per frame at 25 Hz: b per pair, 25 b over 1 s, b (N - 1) at the
+// last frame and at most; the truth against itself gives zeros.
+TEST(Trajectory, RotationMeasuresOfAConstantBias) {
+  const double b = 0.05;
+  const int n = 100;
+  Trajectory truth, estimate;
+  biased_walk(n, 25.0, [&](int k) { return b * k; }, &truth, &estimate);
+  const TrajectoryErrors e = compare_trajectories(estimate, truth, true, 1e-3);
+  EXPECT_EQ(e.pairs, n - 1);
+  EXPECT_NEAR(e.rot_pair_median_deg, b, 1e-9);
+  EXPECT_EQ(e.window_s, 1.0);
+  // Every pose up to 1 s before the last starts a window; so do the next two, whose windows end
+  // at the last pose 1 and 2 frames short of a second (within 10 % of it).
+  ASSERT_EQ(e.rot_window_err_deg.size(), static_cast<size_t>(n - 25 + 2));
+  for (size_t i = 0; i < e.rot_window_err_deg.size(); ++i)
+    EXPECT_NEAR(e.rot_window_err_deg[i], (i < n - 25 ? 25 : n - 1 - static_cast<int>(i)) * b,
+                1e-9)
+        << i;
+  EXPECT_NEAR(e.rot_window_median_deg, 25 * b, 1e-9);
+  EXPECT_NEAR(e.orientation_last_deg, (n - 1) * b, 1e-9);
+  EXPECT_NEAR(e.orientation_max_deg, (n - 1) * b, 1e-9);
+  // Rotations only: the centres agree, so the translation direction errors are the bias seen
+  // from each camera, small but not zero.
+  EXPECT_GT(e.dir_median_deg, 0.0);
+  EXPECT_LT(e.dir_median_deg, 10.0);
+
+  // Another window length: 0.6 s is 15 frames.
+  const TrajectoryErrors short_window =
+      compare_trajectories(estimate, truth, true, 1e-3, nullptr, 0.6);
+  EXPECT_EQ(short_window.window_s, 0.6);
+  EXPECT_EQ(short_window.rot_window_err_deg.size(), static_cast<size_t>(n - 15 + 1));
+  EXPECT_NEAR(short_window.rot_window_median_deg, 15 * b, 1e-9);
+  EXPECT_NEAR(short_window.rot_pair_median_deg, b, 1e-9);
+
+  const TrajectoryErrors same = compare_trajectories(truth, truth, true, 1e-3);
+  EXPECT_NEAR(same.rot_pair_median_deg, 0.0, 1e-9);
+  EXPECT_NEAR(same.rot_window_median_deg, 0.0, 1e-9);
+  EXPECT_NEAR(same.orientation_last_deg, 0.0, 1e-9);
+  EXPECT_NEAR(same.orientation_max_deg, 0.0, 1e-9);
+  EXPECT_NEAR(same.dir_median_deg, 0.0, 1e-6);
+}
+
+// A bias that grows for 40 frames and shrinks back for 20 (8 Hz): the orientation is worst at
+// frame 40 (40 b), 20 b off at the end; over 1 s windows it is 8 b off, except where the window
+// holds the turn of the bias.
+TEST(Trajectory, OrientationErrorPeaksWhereTheBiasTurns) {
+  const double b = 0.1;
+  Trajectory truth, estimate;
+  biased_walk(61, 8.0, [&](int k) { return k <= 40 ? b * k : b * (80 - k); }, &truth,
+              &estimate);
+  const TrajectoryErrors e = compare_trajectories(estimate, truth, true, 1e-3);
+  EXPECT_NEAR(e.orientation_max_deg, 40 * b, 1e-9);
+  EXPECT_NEAR(e.orientation_last_deg, 20 * b, 1e-9);
+  EXPECT_NEAR(e.rot_pair_median_deg, b, 1e-9);
+  ASSERT_EQ(e.rot_window_err_deg.size(), 53u);
+  EXPECT_NEAR(e.rot_window_err_deg[0], 8 * b, 1e-9);
+  EXPECT_NEAR(e.rot_window_err_deg[36], 0.0, 1e-9);  // 4 frames up, 4 down
+  EXPECT_NEAR(e.rot_window_median_deg, 8 * b, 1e-9);
+}
+
+// The translation direction error per pair: an estimate that moves 10 degrees off the true
+// direction (about the world z axis) in every frame.
+TEST(Trajectory, DirectionErrorOfATurnedPath) {
+  Trajectory truth, estimate;
+  const Eigen::Matrix3d turn = rotation(Eigen::Vector3d::UnitZ(), 10.0);
+  for (int k = 0; k < 20; ++k) {
+    StampedPose g;
+    g.stamp = 0.1 * k;
+    g.R = rotation(Eigen::Vector3d(1.0, -0.5, 0.2), 30.0);
+    g.c = Eigen::Vector3d(0.5 * k, 0.0, 0.0);
+    truth.push_back(g);
+    StampedPose e = g;
+    e.c = turn * g.c;
+    estimate.push_back(e);
+  }
+  const TrajectoryErrors e = compare_trajectories(estimate, truth, true, 1e-3);
+  EXPECT_NEAR(e.dir_median_deg, 10.0, 1e-9);
+  EXPECT_NEAR(e.rot_pair_median_deg, 0.0, 1e-9);
+}
+
+// Too short for a window, too few poses, a bad window length and poses that are not finite.
+TEST(Trajectory, RotationMeasuresEdgeCases) {
+  const double b = 0.05;
+  Trajectory truth, estimate;
+  biased_walk(20, 25.0, [&](int k) { return b * k; }, &truth, &estimate);  // 0.76 s
+  const TrajectoryErrors short_run = compare_trajectories(estimate, truth, true, 1e-3);
+  EXPECT_TRUE(short_run.rot_window_err_deg.empty());
+  EXPECT_TRUE(std::isnan(short_run.rot_window_median_deg));
+  EXPECT_NEAR(short_run.rot_pair_median_deg, b, 1e-9);
+  EXPECT_NEAR(short_run.orientation_last_deg, 19 * b, 1e-9);
+  // 10 Hz, the last pose 0.88 s after the first: more than 10 % short of 1 s, no window; at
+  // 0.92 s it ends the first one.
+  Trajectory t10, e10;
+  biased_walk(11, 10.0, [&](int k) { return b * k; }, &t10, &e10);
+  t10.back().stamp = e10.back().stamp = t10[0].stamp + 0.88;
+  EXPECT_TRUE(compare_trajectories(e10, t10, true, 1e-3).rot_window_err_deg.empty());
+  t10.back().stamp = e10.back().stamp = t10[0].stamp + 0.92;
+  const TrajectoryErrors one_window = compare_trajectories(e10, t10, true, 1e-3);
+  ASSERT_EQ(one_window.rot_window_err_deg.size(), 1u);
+  EXPECT_NEAR(one_window.rot_window_err_deg[0], 10 * b, 1e-9);
+
+  const std::vector<PosePair> poses = match_poses(estimate, truth, 1e-3);
+  ASSERT_EQ(poses.size(), 20u);
+  for (const double window : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()})
+    EXPECT_TRUE(window_rotation_errors_deg(poses, window).empty()) << window;
+
+  const TrajectoryErrors one = compare_trajectories({estimate[0]}, truth, true, 1e-3);
+  EXPECT_EQ(one.pairs, 0);
+  EXPECT_TRUE(std::isnan(one.rot_pair_median_deg));
+  EXPECT_TRUE(std::isnan(one.dir_median_deg));
+  EXPECT_TRUE(std::isnan(one.rot_window_median_deg));
+  EXPECT_TRUE(std::isnan(one.orientation_last_deg));
+  EXPECT_TRUE(std::isnan(one.orientation_max_deg));
+
+  // A pose that is not finite, in the estimate or in the truth, is left out; the measures stay
+  // finite and those that do not depend on it unchanged.
+  Trajectory long_truth, long_estimate;
+  biased_walk(100, 25.0, [&](int k) { return b * k; }, &long_truth, &long_estimate);
+  long_estimate[40].R(0, 1) = std::nan("");
+  long_truth[60].c.z() = std::nan("");
+  EXPECT_EQ(match_poses(long_estimate, long_truth, 1e-3).size(), 98u);
+  const TrajectoryErrors holes = compare_trajectories(long_estimate, long_truth, true, 1e-3);
+  EXPECT_EQ(holes.pairs, 97);
+  EXPECT_NEAR(holes.rot_pair_median_deg, b, 1e-9);
+  EXPECT_NEAR(holes.rot_window_median_deg, 25 * b, 1e-9);
+  EXPECT_NEAR(holes.orientation_last_deg, 99 * b, 1e-9);
+  EXPECT_NEAR(holes.orientation_max_deg, 99 * b, 1e-9);
+  EXPECT_TRUE(std::isfinite(holes.dir_median_deg));
+  EXPECT_TRUE(std::isfinite(holes.ate));
 }
 
 Eigen::Matrix3d exp_deg(const Eigen::Vector3d& w_deg) {

@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/pose_error.h"
 
@@ -63,19 +64,79 @@ double angle_deg(const Eigen::Matrix3d& R) {
   return rotation_error(Eigen::Matrix3d::Identity(), R) * 180.0 / M_PI;
 }
 
+bool is_finite(const StampedPose& p) {
+  return std::isfinite(p.stamp) && p.R.allFinite() && p.c.allFinite();
+}
+
+// The angle of (R_est_a^T R_est_b)^T (R_gt_a^T R_gt_b): how far the estimated rotation from
+// pose a to pose b is from the true one.
+double relative_rotation_error_deg(const PosePair& a, const PosePair& b) {
+  const Eigen::Matrix3d dRe = a.estimate.R.transpose() * b.estimate.R;
+  const Eigen::Matrix3d dRg = a.truth.R.transpose() * b.truth.R;
+  return angle_deg(dRe.transpose() * dRg);
+}
+
 }  // namespace
+
+std::vector<PosePair> match_poses(const Trajectory& estimate, const Trajectory& truth,
+                                  double tolerance) {
+  std::vector<PosePair> poses;
+  for (const StampedPose& p : estimate) {
+    PosePair pair;
+    if (!is_finite(p) || !pose_at(truth, p.stamp, tolerance, &pair.truth) ||
+        !is_finite(pair.truth))
+      continue;
+    pair.estimate = p;
+    poses.push_back(pair);
+  }
+  std::stable_sort(poses.begin(), poses.end(), [](const PosePair& a, const PosePair& b) {
+    return a.estimate.stamp < b.estimate.stamp;
+  });
+  return poses;
+}
+
+std::vector<double> window_rotation_errors_deg(const std::vector<PosePair>& poses,
+                                               double window_s) {
+  std::vector<double> errors;
+  if (poses.size() < 2 || !std::isfinite(window_s) || !(window_s > 0.0)) return errors;
+  std::vector<double> stamps;
+  for (const PosePair& p : poses) stamps.push_back(p.estimate.stamp);
+  // Not half a frame: the node's trajectory has poses at its estimated frames only, a few
+  // frames apart, and a window of 0.9-1.1 s still measures the drift over about a second.
+  const double tolerance = 0.1 * window_s;
+  for (size_t i = 0; i + 1 < poses.size(); ++i) {
+    const double target = stamps[i] + window_s;
+    const auto after = std::lower_bound(stamps.begin() + i + 1, stamps.end(), target);
+    size_t best = poses.size();
+    double best_gap = tolerance;
+    if (after != stamps.end() && *after - target <= best_gap)
+      best = after - stamps.begin(), best_gap = *after - target;
+    if (after - stamps.begin() > static_cast<std::ptrdiff_t>(i + 1) &&
+        target - *(after - 1) <= best_gap)
+      best = after - 1 - stamps.begin();
+    if (best < poses.size()) errors.push_back(relative_rotation_error_deg(poses[i], poses[best]));
+  }
+  return errors;
+}
+
+std::vector<double> orientation_errors_deg(const std::vector<PosePair>& poses) {
+  std::vector<double> errors;
+  for (const PosePair& p : poses) errors.push_back(relative_rotation_error_deg(poses[0], p));
+  return errors;
+}
 
 TrajectoryErrors compare_trajectories(const Trajectory& estimate, const Trajectory& truth,
                                       bool with_scale, double tolerance,
                                       std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>*
-                                          aligned) {
+                                          aligned,
+                                      double window_s) {
   TrajectoryErrors e;
+  e.window_s = window_s;
+  const std::vector<PosePair> poses = match_poses(estimate, truth, tolerance);
   std::vector<StampedPose> est, gt;
-  for (const StampedPose& p : estimate) {
-    StampedPose g;
-    if (!pose_at(truth, p.stamp, tolerance, &g)) continue;
-    est.push_back(p);
-    gt.push_back(g);
+  for (const PosePair& p : poses) {
+    est.push_back(p.estimate);
+    gt.push_back(p.truth);
   }
   if (est.size() < 2) return e;
   std::vector<Eigen::Vector3d> ce, cg;
@@ -116,6 +177,13 @@ TrajectoryErrors compare_trajectories(const Trajectory& estimate, const Trajecto
   }
   e.rpe_trans = std::sqrt(rpe_t / e.pairs);
   e.rpe_rot_deg = std::sqrt(rpe_r / e.pairs);
+  e.rot_pair_median_deg = median(e.rot_err_deg);
+  e.dir_median_deg = median(e.dir_err_deg);
+  e.rot_window_err_deg = window_rotation_errors_deg(poses, window_s);
+  e.rot_window_median_deg = median(e.rot_window_err_deg);
+  const std::vector<double> orientation = orientation_errors_deg(poses);
+  e.orientation_last_deg = orientation.back();
+  e.orientation_max_deg = *std::max_element(orientation.begin(), orientation.end());
 
   // Drift over sub-sequences (KITTI devkit style), with fractions of the path when it is short.
   std::vector<double> distance(gt.size(), 0.0);

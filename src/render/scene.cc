@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "painter.h"
+#include "plain_surfaces.h"
 #include "surfaces.h"
 
 namespace hybrid_vo {
@@ -211,6 +212,21 @@ bool parse_scene_type(const std::string& name, SceneType* type) {
 
 const char* to_string(SceneType type) { return type == SceneType::kCorridor ? "corridor" : "room"; }
 
+bool parse_texture_style(const std::string& name, TextureStyle* style) {
+  if (name == "textured") {
+    *style = TextureStyle::kTextured;
+  } else if (name == "plain") {
+    *style = TextureStyle::kPlain;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+const char* to_string(TextureStyle style) {
+  return style == TextureStyle::kTextured ? "textured" : "plain";
+}
+
 int Quad::normal_axis() const {
   int axis = 0;
   normal.cwiseAbs().maxCoeff(&axis);
@@ -392,25 +408,41 @@ Scene build_scene(const SceneOptions& options_in) {
   }
   const uint64_t ceiling_seed = rng.next();
   std::vector<std::vector<Eigen::Vector2d>> corners(scene.quads.size());
+  // Which box a furniture quad belongs to: cabinets have four sides and a top, the pillar four
+  // sides.
+  auto box_of = [&](size_t quad) {
+    size_t box = 0, first = first_box;
+    for (; box < scene.boxes.size(); ++box) {
+      const size_t faces = box < num_cabinets ? 5 : 4;
+      if (quad < first + faces) break;
+      first += faces;
+    }
+    return box;
+  };
+  const bool plain = o.texture == TextureStyle::kPlain;
   for (size_t i = 0; i < scene.quads.size(); ++i) {
     Quad& q = scene.quads[i];
     const double albedo = q.kind == SurfaceKind::kCeiling ? 0.74 : 0.5;
     Canvas canvas(q.size_u, q.size_v, tpm, albedo);
     Rng surface(hash_mix(o.seed, 1000 + i));
-    if (q.kind == SurfaceKind::kFloor) {
+    if (plain) {
+      if (q.kind == SurfaceKind::kFloor) {
+        paint_plain_floor(&canvas, q, floor.seed);
+      } else if (q.kind == SurfaceKind::kCeiling) {
+        paint_plain_ceiling(&canvas, q, scene.lights);
+      } else if (i < first_box) {
+        paint_plain_wall(&canvas, layouts[i - first_wall], surface, &corners[i]);
+      } else {
+        canvas.rect(0.0, 0.0, q.size_u, q.size_v, plain_box_albedo(hash_mix(o.seed, box_of(i))));
+      }
+    } else if (q.kind == SurfaceKind::kFloor) {
       paint_floor(&canvas, q, floor);
     } else if (q.kind == SurfaceKind::kCeiling) {
       paint_ceiling(&canvas, q, scene.lights, hash_mix(ceiling_seed, i));
     } else if (i < first_box) {
       paint_wall(&canvas, layouts[i - first_wall], surface, &corners[i]);
     } else {
-      // Cabinets have four sides and a top; the pillar four sides.
-      size_t box = 0, first = first_box;
-      for (; box < scene.boxes.size(); ++box) {
-        const size_t faces = box < num_cabinets ? 5 : 4;
-        if (i < first + faces) break;
-        first += faces;
-      }
+      const size_t box = box_of(i);
       if (box < num_cabinets) {
         // The front faces the way of the wall the cabinet stands against.
         const bool front = q.normal.dot(cabinet_front[box]) > 0.5;

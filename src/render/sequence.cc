@@ -47,10 +47,11 @@ bool parse_u64(const std::string& s, uint64_t* out) {
 
 std::string sequence_usage(const std::string& program) {
   std::ostringstream s;
-  s << "Usage: " << program << " --out OUT.bag [options]\n"
+  s << "Usage: " << program << " --out OUT.bag | --kitti-dir DIR [options]\n"
     << "Renders a synthetic Manhattan sequence (textured corridor or room, a walk with turns)\n"
     << "into a bag: /camera/left/{image_raw,camera_info} (and /camera/right/... with --stereo),\n"
-    << "/ground_truth/pose, /tf (world -> gt_camera_left_optical) and /tf_static.\n"
+    << "/ground_truth/pose, /tf (world -> gt_camera_left_optical) and /tf_static; and/or into\n"
+    << "the KITTI odometry layout.\n"
     << "  --frames N         frames (default 150)\n"
     << "  --laps L           instead of --frames: L laps of the closed route (e.g. 1 for a loop)\n"
     << "  --stereo           also render the right camera\n"
@@ -58,13 +59,18 @@ std::string sequence_usage(const std::string& program) {
     << "  --rate HZ          frame rate (default 10)\n"
     << "  --seed S           scene, walk and noise seed (default 1)\n"
     << "  --scene corridor|room  (default corridor)\n"
+    << "  --texture textured|plain  surfaces: posters, doors, tiles (default), or plain\n"
+    << "                     (low texture: only the edges of walls, boxes, doors, floor joints)\n"
     << "  --baseline M       stereo baseline in metres (default 0.12)\n"
     << "  --speed M_PER_S    walking speed (default 1.5)\n"
     << "  --focal PX         focal length (default 0.72 * width)\n"
     << "  --noise SIGMA      image noise in grey levels (default 1)\n"
     << "  --supersampling K  K x K rays per pixel (default 3)\n"
     << "  --compression none|lz4|bz2  bag compression (default lz4)\n"
-    << "  --png-dir DIR      also write the images as PNG files\n";
+    << "  --png-dir DIR      also write the images as PNG files\n"
+    << "  --kitti-dir DIR    also write DIR/sequences/NAME/{image_0,image_1,calib.txt,times.txt}\n"
+    << "                     and DIR/poses/NAME.txt (left camera-to-world in the scene's world)\n"
+    << "  --kitti-name NAME  the KITTI sequence name (default 00)\n";
   return s.str();
 }
 
@@ -82,7 +88,8 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     static const char* kValued[] = {"--out",           "--png-dir",    "--frames", "--width",
                                     "--height",        "--rate",       "--seed",   "--scene",
                                     "--baseline",      "--speed",      "--focal",  "--noise",
-                                    "--supersampling", "--compression", "--laps"};
+                                    "--supersampling", "--compression", "--laps",
+                                    "--texture",       "--kitti-dir",   "--kitti-name"};
     bool known = false;
     for (const char* name : kValued) known = known || arg == name;
     if (!known) return "unknown argument '" + arg + "'";
@@ -109,6 +116,14 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       ok = parse_u64(v, &o->seed);
     } else if (arg == "--scene") {
       ok = parse_scene_type(v, &o->scene);
+    } else if (arg == "--texture") {
+      ok = parse_texture_style(v, &o->texture);
+    } else if (arg == "--kitti-dir") {
+      o->kitti_dir = v;
+      ok = !v.empty();
+    } else if (arg == "--kitti-name") {
+      o->kitti_name = v;
+      ok = !v.empty() && v != "." && v != ".." && v.find('/') == std::string::npos;
     } else if (arg == "--baseline") {
       ok = parse_double(v, 0.0, 2.0, true, &o->baseline);
     } else if (arg == "--speed") {
@@ -125,7 +140,8 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     }
     if (!ok) return "bad value '" + v + "' for " + arg;
   }
-  if (o->out_bag.empty()) return "--out OUT.bag is required";
+  if (o->out_bag.empty() && o->kitti_dir.empty())
+    return "--out OUT.bag or --kitti-dir DIR is required";
   return "";
 }
 
@@ -151,6 +167,7 @@ Sequence make_sequence(const SequenceOptions& options) {
   seq.options = options;
   SceneOptions scene;
   scene.type = options.scene;
+  scene.texture = options.texture;
   scene.seed = options.seed;
   seq.scene = build_scene(scene);
   if (options.laps > 0.0) {

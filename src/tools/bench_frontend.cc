@@ -231,6 +231,9 @@ int run(int argc, char** argv) {
     datasets::read_kitti_poses(root + "/../poses/" + name + ".txt", &gt, &ignored);
   }
   std::vector<double> pose_errors, rotation_nees;
+  // The rotation and translation direction errors of the estimated pairs (status OK), as
+  // hybrid_vo_eval_trajectory takes them from the node's MotionEstimate messages.
+  std::vector<double> pair_rot_deg, pair_dir_deg;
   evaluation::Trajectory estimate, truth, odometry;
   // Stamps from times.txt (1 s added, as kitti_to_bag does), so that a sequence with frames left
   // out has the gaps a live camera's dropped frames leave; 10 Hz without the file.
@@ -252,7 +255,8 @@ int run(int argc, char** argv) {
 
   VisualOdometry vo(o);
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
-      stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, started;
+      stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, started, junctions,
+      junction_inliers, vp_matches, vp_inliers;
   int ok = 0;
   double lines_sum = 0.0, inliers_sum = 0.0;
   const auto run_start = std::chrono::steady_clock::now();
@@ -280,15 +284,18 @@ int run(int argc, char** argv) {
       estimate.push_back(odometry.back());
       truth.push_back(g);
       const int reference = frame_of(r.reference_stamp);
-      if (i > 0 && reference >= 0 && reference < i) {
+      // A frame skipped for too little parallax is no pair, as hybrid_vo_eval_trajectory skips
+      // the node's STATUS_SKIPPED; a failure to estimate counts as an error of 180 degrees.
+      if (i > 0 && reference >= 0 && reference < i && r.status != VoStatus::kLowParallax) {
         double error = 180.0;
         if (r.status == VoStatus::kOk) {
           const datasets::KittiPose& a = gt[reference];
           const datasets::KittiPose& b = gt[i];
           const RelativePose truth_pose{b.R_wc.transpose() * a.R_wc,
                                         b.R_wc.transpose() * (a.c_w - b.c_w)};
-          error = std::max(rotation_error(r.motion.R, truth_pose.R),
-                           translation_error(r.motion.t, truth_pose.t)) * 180.0 / M_PI;
+          pair_rot_deg.push_back(rotation_error(r.motion.R, truth_pose.R) * 180.0 / M_PI);
+          pair_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
+          error = std::max(pair_rot_deg.back(), pair_dir_deg.back());
           // Whether the estimator's rotation covariance predicts its error: the normalised
           // squared error, chi-square with 3 dof when it does.
           if (r.estimate.estimate.covariance_valid) {
@@ -377,6 +384,10 @@ int run(int argc, char** argv) {
       scaled.push_back(r.stereo_scale.status == StereoScaleStatus::kOk ? 1.0 : 0.0);
     line_matches.push_back(r.num_line_matches);
     line_inliers.push_back(r.estimate.estimate.num_line_inliers);
+    junctions.push_back(r.estimate.estimate.junctions.size());
+    junction_inliers.push_back(r.estimate.estimate.num_junction_inliers);
+    vp_matches.push_back(r.matches.vps.size());
+    vp_inliers.push_back(r.estimate.estimate.num_vp_inliers);
     lines_sum += r.num_line_matches;
     inliers_sum += r.estimate.estimate.num_line_inliers;
     tracked.push_back(r.line_tracking.matched);
@@ -400,6 +411,10 @@ int run(int argc, char** argv) {
               "found %.0f, started %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
               median(line_matches), median(line_inliers), median(tracked), median(started),
               lines_sum > 0.0 ? inliers_sum / lines_sum : 0.0, lines_sum);
+  std::printf("median per estimated frame: junctions %.0f (%.0f inliers), VPs %.0f (%.0f "
+              "inliers)\n",
+              median(junctions), median(junction_inliers), median(vp_matches),
+              median(vp_inliers));
   if (!pose_errors.empty()) {
     const evaluation::TrajectoryErrors te =
         evaluation::compare_trajectories(estimate, truth, !stereo, 0.01);
@@ -409,6 +424,12 @@ int run(int argc, char** argv) {
                 100.0 * pose_auc(pose_errors, 10.0), 100.0 * pose_auc(pose_errors, 20.0),
                 te.drift_trans_percent, te.drift_rot_deg_per_100m, te.ate,
                 stereo ? "metric" : "scale aligned", te.rpe_rot_deg);
+    std::printf("rotation error (deg): median %.3f per estimated pair (%zu), %.3f over %g s "
+                "windows (%zu), orientation against the first frame %.3f at the last frame and "
+                "%.3f at most; median translation direction error %.2f deg\n",
+                median(pair_rot_deg), pair_rot_deg.size(), te.rot_window_median_deg, te.window_s,
+                te.rot_window_err_deg.size(), te.orientation_last_deg, te.orientation_max_deg,
+                median(pair_dir_deg));
     if (!rotation_nees.empty())
       std::printf("rotation NEES (3 if the covariance is right): median %.1f over %zu pairs\n",
                   median(rotation_nees), rotation_nees.size());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <string>
@@ -29,11 +30,18 @@ constexpr double kDeg = 180.0 / M_PI;
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
-            << " --bag RUN.bag --gt GT.bag [--gt-topic /ground_truth/pose] [--plot OUT.png]\n"
-               "       " << program << " --tum EST.txt GT.txt [--plot OUT.png]\n"
+            << " --bag RUN.bag --gt GT.bag [--gt-topic /ground_truth/pose] [--plot OUT.png]"
+               " [--window S]\n"
+               "       " << program << " --tum EST.txt GT.txt [--plot OUT.png] [--window S]\n"
                "  Per-pair rotation and translation-direction errors with AUC@5/10/20, RPE, ATE\n"
                "  after alignment (similarity without metric scale), KITTI-style drift, and a plot.\n"
-               "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n";
+               "  Rotation in degrees: median per pair (the node's estimates with status OK, else\n"
+               "  consecutive poses), median over windows of S seconds (default 1), orientation\n"
+               "  against the first frame at the last frame and at most; the median translation\n"
+               "  direction error.\n"
+               "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n"
+               "  rot_pair_deg=X rot_window_deg=X window_s=S orient_last_deg=X orient_max_deg=X\n"
+               "  dir_deg=X\n";
 }
 
 using evaluation::median;
@@ -138,6 +146,7 @@ bool read_gt(const std::string& path, const std::string& topic, Trajectory* gt, 
 
 int main(int argc, char** argv) {
   std::string bag, gt_bag, gt_topic = "/ground_truth/pose", tum_est, tum_gt, plot;
+  double window_s = evaluation::kDefaultRotationWindowSeconds;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -151,6 +160,16 @@ int main(int argc, char** argv) {
     else if (a == "--gt") gt_bag = next();
     else if (a == "--gt-topic") gt_topic = next();
     else if (a == "--plot") plot = next();
+    else if (a == "--window") {
+      const std::string v = next();
+      char* end = nullptr;
+      window_s = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end || !std::isfinite(window_s) || !(window_s > 0.0)) {
+        std::cerr << "error: --window: expected a positive number of seconds, got '" << v
+                  << "'\n";
+        return 2;
+      }
+    }
     else if (a == "--tum") {
       tum_est = next();
       tum_gt = next();
@@ -185,6 +204,8 @@ int main(int argc, char** argv) {
 
   // Per-pair errors: the node's own relative poses when recorded, else consecutive poses.
   std::vector<double> errors;
+  // The rotation and translation direction errors of the estimated pairs (status OK).
+  std::vector<double> pair_rot, pair_dir;
   int failures = 0, skipped = 0;
   // With a metric scale, the ratio of the estimated to the true translation length per pair: a
   // scale bias shows at a glance, not only through the drift.
@@ -210,6 +231,8 @@ int main(int argc, char** argv) {
         const Eigen::Vector3d t_gt = b.R.transpose() * (a.c - b.c);
         rot = hybrid_vo::rotation_error(R, R_gt) * kDeg;
         dir = hybrid_vo::translation_error(t, t_gt) * kDeg;
+        pair_rot.push_back(rot);
+        pair_dir.push_back(dir);
         if (m.scale_known && t_gt.norm() > 1e-9) {
           ratio = t.norm() / t_gt.norm();
           scale_ratios.push_back(ratio);
@@ -227,8 +250,11 @@ int main(int argc, char** argv) {
   const bool with_scale = run.scale_known * 2 < static_cast<int>(run.motions.size()) || run.motions.empty();
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> aligned;
   const evaluation::TrajectoryErrors te =
-      evaluation::compare_trajectories(run.trajectory, gt, with_scale, tolerance, &aligned);
+      evaluation::compare_trajectories(run.trajectory, gt, with_scale, tolerance, &aligned,
+                                       window_s);
   if (run.motions.empty()) {
+    pair_rot = te.rot_err_deg;
+    pair_dir = te.dir_err_deg;
     for (size_t i = 0; i < te.rot_err_deg.size(); ++i) {
       errors.push_back(std::max(te.rot_err_deg[i], te.dir_err_deg[i]));
       std::printf("%zu,,,0,%.4f,%.4f,\n", i, te.rot_err_deg[i], te.dir_err_deg[i]);
@@ -271,7 +297,8 @@ int main(int argc, char** argv) {
   // overlap: the segments and the stereo matching run on a second thread), and the matches.
   if (!run.motions.empty()) {
     std::vector<double> frontend, estimator, total, points, redetect, lines, line_matching, vps,
-        ransac, stereo, point_matches, point_inliers, line_matches, line_inliers;
+        ransac, stereo, point_matches, point_inliers, line_matches, line_inliers, junctions,
+        junction_inliers, vp_matches, vp_inliers;
     double lines_sum = 0.0, line_inliers_sum = 0.0;
     for (const hybrid_vo::MotionEstimate& m : run.motions) {
       frontend.push_back(m.frontend_ms);
@@ -289,6 +316,10 @@ int main(int argc, char** argv) {
       point_inliers.push_back(m.point_inliers);
       line_matches.push_back(m.lines);
       line_inliers.push_back(m.line_inliers);
+      junctions.push_back(m.junctions);
+      junction_inliers.push_back(m.junction_inliers);
+      vp_matches.push_back(m.vps);
+      vp_inliers.push_back(m.vp_inliers);
       lines_sum += m.lines;
       line_inliers_sum += m.line_inliers;
     }
@@ -304,14 +335,27 @@ int main(int argc, char** argv) {
                 median(ransac), median(stereo));
     if (!point_matches.empty())
       std::printf("# matches per estimated frame (median): points %.0f (%.0f inliers), lines %.0f "
-                  "(%.0f inliers); line inlier ratio %.3f (all frames pooled)\n",
+                  "(%.0f inliers), junctions %.0f (%.0f inliers), VPs %.0f (%.0f inliers); line "
+                  "inlier ratio %.3f (all frames pooled)\n",
                   median(point_matches), median(point_inliers), median(line_matches),
-                  median(line_inliers), lines_sum > 0.0 ? line_inliers_sum / lines_sum : 0.0);
+                  median(line_inliers), median(junctions), median(junction_inliers),
+                  median(vp_matches), median(vp_inliers),
+                  lines_sum > 0.0 ? line_inliers_sum / lines_sum : 0.0);
   }
+  const double rot_pair = median(pair_rot), dir = median(pair_dir);
+  std::printf("# rotation error (deg): median %.3f per pair (%zu %s), %.3f over %g s windows (%zu), "
+              "orientation against the first frame %.3f at the last frame and %.3f at most; "
+              "median translation direction error %.2f deg\n",
+              rot_pair, pair_rot.size(),
+              run.motions.empty() ? "pairs of consecutive poses" : "estimated pairs",
+              te.rot_window_median_deg, window_s, te.rot_window_err_deg.size(),
+              te.orientation_last_deg, te.orientation_max_deg, dir);
   std::printf("summary: pairs=%zu auc5=%.2f auc10=%.2f auc20=%.2f rpe_trans=%.4f rpe_rot_deg=%.4f "
-              "ate=%.4f\n",
+              "ate=%.4f rot_pair_deg=%.4f rot_window_deg=%.4f window_s=%g orient_last_deg=%.4f "
+              "orient_max_deg=%.4f dir_deg=%.3f\n",
               errors.size(), 100.0 * hybrid_vo::pose_auc(errors, 5.0),
               100.0 * hybrid_vo::pose_auc(errors, 10.0), 100.0 * hybrid_vo::pose_auc(errors, 20.0),
-              te.rpe_trans, te.rpe_rot_deg, te.ate);
+              te.rpe_trans, te.rpe_rot_deg, te.ate, rot_pair, te.rot_window_median_deg, window_s,
+              te.orientation_last_deg, te.orientation_max_deg, dir);
   return 0;
 }

@@ -1,6 +1,6 @@
 // hybrid_vo_render_sequence: renders the synthetic Manhattan sequence (render/sequence.h) into a
-// bag with images, camera_info, ground-truth poses and tf; the demo's default data and the
-// rostest fixture.
+// bag with images, camera_info, ground-truth poses and tf (the demo's default data and the
+// rostest fixture), and/or into the KITTI odometry layout (the ROS-free tools' input).
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "hybrid_vo/conversion/bag_writing.h"
+#include "hybrid_vo/datasets/kitti_writer.h"
 #include "hybrid_vo/render/sequence.h"
 
 namespace {
@@ -41,7 +42,8 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << error << "\n" << sequence_usage(program);
     return 2;
   }
-  if (const std::string why = check_writable_file(options.out_bag); !why.empty()) {
+  const bool to_bag = !options.out_bag.empty(), to_kitti = !options.kitti_dir.empty();
+  if (const std::string why = to_bag ? check_writable_file(options.out_bag) : ""; !why.empty()) {
     std::cerr << "error: cannot write the bag: " << why << "\n";
     return 1;
   }
@@ -65,8 +67,15 @@ int main(int argc, char** argv) {
                                        : rosbag::compression::Uncompressed;
     BagOutput out;
     std::string bag_error;
-    if (!out.open(options.out_bag, compression, &bag_error)) {
+    if (to_bag && !out.open(options.out_bag, compression, &bag_error)) {
       std::cerr << "error: cannot write the bag: " << bag_error << "\n";
+      return 1;
+    }
+    hybrid_vo::datasets::KittiWriter kitti;
+    std::string kitti_error;
+    if (to_kitti && !kitti.open(options.kitti_dir, options.kitti_name, seq.camera,
+                                options.stereo ? options.baseline : 0.0, &kitti_error)) {
+      std::cerr << "error: " << kitti_error << "\n";
       return 1;
     }
     const std::string left = conversion::optical_frame("left");
@@ -83,24 +92,28 @@ int main(int argc, char** argv) {
           conversion::stamped(conversion::kBaseFrame, right, t0,
                               conversion::to_transform(base_from_optical(), right_in_base)));
     }
-    out.write_tf_static(t0, statics, "/hybrid_vo_render_sequence");
+    if (to_bag) out.write_tf_static(t0, statics, "/hybrid_vo_render_sequence");
 
     const double tx_right = -seq.camera.fx * options.baseline;
     double render_seconds = 0.0;
     for (int i = 0; i < seq.options.frames; ++i) {
       const ros::Time t = stamp_of(i, options.rate);
+      cv::Mat images[2];
       for (int side = 0; side < (options.stereo ? 2 : 1); ++side) {
         const bool is_right = side == 1;
         const auto r0 = std::chrono::steady_clock::now();
         const RenderedView view = render_frame(seq, i, is_right);
         render_seconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+        images[side] = view.image;
         const std::string prefix = conversion::camera_topic(is_right ? "right" : "left");
         const std::string& frame = is_right ? right : left;
-        out.write_image(prefix + "/image_raw", frame, t, view.image);
-        out.bag().write(
-            prefix + "/camera_info", t,
-            conversion::make_camera_info(seq.camera, frame, t, is_right ? tx_right : 0.0));
+        if (to_bag) {
+          out.write_image(prefix + "/image_raw", frame, t, view.image);
+          out.bag().write(
+              prefix + "/camera_info", t,
+              conversion::make_camera_info(seq.camera, frame, t, is_right ? tx_right : 0.0));
+        }
         if (!options.png_dir.empty()) {
           char name[64];
           std::snprintf(name, sizeof(name), "%s_%06d.png", is_right ? "right" : "left", i);
@@ -112,22 +125,40 @@ int main(int argc, char** argv) {
         }
       }
       const CameraPose& pose = seq.trajectory.poses[i];
-      out.write_ground_truth(conversion::ground_truth_frame(left), t, pose.R_world_from_camera,
-                             pose.centre);
+      if (to_bag)
+        out.write_ground_truth(conversion::ground_truth_frame(left), t, pose.R_world_from_camera,
+                               pose.centre);
+      // KITTI's times start at 0; hybrid_vo_kitti_to_bag adds the 1 s the bag starts at.
+      const double time = 1e-9 * static_cast<double>(frame_stamp_ns(i, options.rate) -
+                                                     frame_stamp_ns(0, options.rate));
+      if (to_kitti && !kitti.add_frame(time, images[0], images[1], pose.R_world_from_camera,
+                                       pose.centre, &kitti_error)) {
+        std::cerr << "error: " << kitti_error << "\n";
+        return 1;
+      }
     }
-    if (!out.commit(&bag_error)) {
+    if (to_bag && !out.commit(&bag_error)) {
       std::cerr << "error: " << bag_error << "\n";
+      return 1;
+    }
+    if (to_kitti && !kitti.close(&kitti_error)) {
+      std::cerr << "error: " << kitti_error << "\n";
       return 1;
     }
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const int views = seq.options.frames * (options.stereo ? 2 : 1);
+    std::string outputs = options.out_bag;
+    if (to_kitti)
+      outputs += (to_bag ? " and " : "") + kitti.sequence_dir() + " (poses " + kitti.poses_path() +
+                 ")";
     std::printf(
-        "rendered %d frames (%s, %dx%d, %s, %.0f Hz), path %.1f m, turned %.0f deg, "
+        "rendered %d frames (%s, %dx%d, %s, %s, %.0f Hz), path %.1f m, turned %.0f deg, "
         "%.3f s per view, %.1f s total -> %s\n",
         seq.options.frames, options.stereo ? "stereo" : "mono", options.width, options.height,
-        to_string(options.scene), options.rate, seq.trajectory.length,
-        seq.trajectory.total_turn_deg, render_seconds / views, total, options.out_bag.c_str());
+        to_string(options.scene), to_string(options.texture), options.rate,
+        seq.trajectory.length, seq.trajectory.total_turn_deg, render_seconds / views, total,
+        outputs.c_str());
   } catch (const rosbag::BagException& e) {
     std::cerr << "error: cannot write the bag '" << options.out_bag << "': " << e.what() << "\n";
     return 1;

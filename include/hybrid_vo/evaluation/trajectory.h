@@ -3,6 +3,7 @@
 // Trajectory comparison shared by the evaluation tools: camera poses by time, relative errors,
 // alignment (Umeyama) and drift.
 
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -28,10 +29,45 @@ bool pose_at(const Trajectory& trajectory, double stamp, double tolerance, Stamp
 bool umeyama(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to,
              bool with_scale, Eigen::Matrix3d* R, Eigen::Vector3d* t, double* s);
 
+// An estimated pose and the ground truth at its stamp.
+struct PosePair {
+  StampedPose estimate, truth;
+};
+
+// The estimate's poses that have a ground-truth pose within `tolerance` seconds (the nearest
+// sample), sorted by stamp. Poses with a non-finite stamp, rotation or centre, in the estimate
+// or in the truth, are left out: they are not poses.
+std::vector<PosePair> match_poses(const Trajectory& estimate, const Trajectory& truth,
+                                  double tolerance);
+
+// Rotation error over windows of `window_s` seconds: for each pose i, the pose j whose stamp is
+// nearest to stamp_i + window_s, skipped unless it is within 10 % of the window; the error of
+// the relative rotation i -> j is the angle of R_est_rel^T R_gt_rel, in degrees. Drift accumulates over the window, so a constant rotation
+// bias of b degrees per frame gives b times the frames per window. Empty when the poses span
+// less than a window or window_s is not a positive number.
+std::vector<double> window_rotation_errors_deg(const std::vector<PosePair>& poses,
+                                               double window_s);
+
+// The orientation error of each pose relative to the first, in degrees: the angle of
+// (R_est_0^T R_est_k)^T (R_gt_0^T R_gt_k). Zero for the first pose; it accumulates every
+// rotation error since (a bias of b degrees per frame about one axis gives b k).
+std::vector<double> orientation_errors_deg(const std::vector<PosePair>& poses);
+
+constexpr double kDefaultRotationWindowSeconds = 1.0;
+
 struct TrajectoryErrors {
   int pairs = 0;                    // consecutive pose pairs compared
   std::vector<double> rot_err_deg;  // per pair: rotation error of the relative motion
   std::vector<double> dir_err_deg;  // per pair: angle between the translation directions
+  // Rotation measures in degrees; NaN when there is nothing to measure (fewer than 2 poses, or
+  // for the windows a sequence shorter than one window).
+  double rot_pair_median_deg = NAN;  // median of rot_err_deg
+  double dir_median_deg = NAN;       // median of dir_err_deg
+  double window_s = kDefaultRotationWindowSeconds;
+  std::vector<double> rot_window_err_deg;  // window_rotation_errors_deg over window_s
+  double rot_window_median_deg = NAN;
+  // orientation_errors_deg: at the last compared pose, and the largest over all of them.
+  double orientation_last_deg = NAN, orientation_max_deg = NAN;
   double rpe_trans = 0.0;           // RMSE of the relative translation (after scale alignment)
   double rpe_rot_deg = 0.0;         // RMSE of the relative rotation
   double ate = 0.0;                 // RMSE of positions after alignment
@@ -44,13 +80,15 @@ struct TrajectoryErrors {
   double drift_rot_deg_per_100m = 0.0;
 };
 
-// Compares an estimated trajectory with the ground truth at the estimate's stamps (GT matched
+// Compares an estimated trajectory with the ground truth at the estimate's stamps (match_poses
 // within `tolerance`). With `with_scale` (monocular), a similarity aligns them for ATE and RPE;
-// otherwise a rigid transform.
+// otherwise a rigid transform. Pairs are consecutive compared poses; the rotation windows are
+// `window_s` long.
 TrajectoryErrors compare_trajectories(const Trajectory& estimate, const Trajectory& truth,
                                       bool with_scale, double tolerance,
                                       std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>*
-                                          aligned = nullptr);
+                                          aligned = nullptr,
+                                      double window_s = kDefaultRotationWindowSeconds);
 
 // The rotation of camera `to` relative to camera `from` of a camera-to-world trajectory, as a
 // relative pose has it: X_to = R X_from.

@@ -1,7 +1,8 @@
 #pragma once
 
 // A textured Manhattan interior for the synthetic sequence renderer: a ring corridor around a
-// block of rooms, or a single room, built from axis-aligned textured rectangles. World frame:
+// block of rooms, or a single room, built from axis-aligned textured rectangles; or the same
+// interior with plain surfaces (low texture). World frame:
 // metres, z up, floor at z = 0, the floor plan inside [0, size_x] x [0, size_y]; its x, y, z axes
 // are the three Manhattan directions. Everything is deterministic from the seed (std::
 // distributions differ between standard libraries, so the scene uses its own generator).
@@ -26,6 +27,19 @@ enum class SceneType {
 bool parse_scene_type(const std::string& name, SceneType* type);
 const char* to_string(SceneType type);
 
+// What the surfaces look like; the geometry, the lights and the walk are the same either way.
+enum class TextureStyle {
+  kTextured,  // posters, doors, windows, boards, tiles, acoustic panels: hundreds of corners
+  // Low texture: one plain albedo per surface, a few grey levels from its neighbours, lit as
+  // the textured ones. Only edges remain: walls, floor, ceiling and plain boxes meeting, a few
+  // plain door frames, thin floor joints and flush light panels.
+  kPlain,
+};
+
+// Parses "textured" or "plain"; false for anything else.
+bool parse_texture_style(const std::string& name, TextureStyle* style);
+const char* to_string(TextureStyle style);
+
 struct SceneOptions {
   SceneType type = SceneType::kCorridor;
   uint64_t seed = 1;
@@ -36,6 +50,7 @@ struct SceneOptions {
   double size_x = 0.0, size_y = 0.0;
   double texels_per_metre = 256.0;  // albedo texture resolution of walls and floors
   int num_furniture = 4;            // cabinets against the walls (0..12)
+  TextureStyle texture = TextureStyle::kTextured;
 };
 
 // A rectangular albedo texture with its mip chain (level k halves level k - 1 exactly: level 0

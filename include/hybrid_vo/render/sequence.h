@@ -17,8 +17,12 @@ namespace hybrid_vo {
 namespace render {
 
 struct SequenceOptions {
-  std::string out_bag;  // required
+  std::string out_bag;  // empty: no bag (then kitti_dir is required)
   std::string png_dir;  // empty: no PNGs
+  // Not empty: also the KITTI odometry layout (datasets/kitti_writer.h), as
+  // <kitti_dir>/sequences/<kitti_name>/ and <kitti_dir>/poses/<kitti_name>.txt.
+  std::string kitti_dir;
+  std::string kitti_name = "00";
   int frames = 150;
   // > 0: the frame count is this many laps of the scene's closed route at `speed` and `rate`
   // (rounded), replacing `frames`; one lap replayed in a loop makes an endless walk.
@@ -28,6 +32,7 @@ struct SequenceOptions {
   double rate = 10.0;  // Hz
   uint64_t seed = 1;   // scene, sway and noise
   SceneType scene = SceneType::kCorridor;
+  TextureStyle texture = TextureStyle::kTextured;
   double baseline = 0.12;  // metres, stereo only
   double speed = 1.5;      // metres per second
   double focal = 0.0;      // pixels; 0: 0.72 * width
