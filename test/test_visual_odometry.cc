@@ -391,6 +391,39 @@ TEST(LineTracker, KeepsIdsThroughMotionAndAMissedFrameAndStartsAfreshBackwards) 
     EXPECT_EQ(std::count(sorted_first.begin(), sorted_first.end(), id), 0);
 }
 
+// A sudden jump of 40 px (a turn starting): the rotation's prediction carries every track
+// there; without it, the search keeps only the edges that slid along themselves and the
+// descriptors re-identify the rest; with neither, those start afresh.
+TEST(LineTracker, JumpsAreFollowedByTheRotationOrReidentified) {
+  const LineMatchingOptions matching = video_line_matching_options();
+  const LineFeatures before = detect_line_features(moving_rectangles(0.0), matching);
+  const LineFeatures after = detect_line_features(moving_rectangles(40.0), matching);
+  ASSERT_GE(before.segments.size(), 6u);
+  ASSERT_EQ(before.segments.size(), after.segments.size());
+  const int n = static_cast<int>(after.segments.size());
+  Eigen::Matrix3d shift = Eigen::Matrix3d::Identity();
+  shift(0, 2) = 40.0;
+  auto run = [&](bool reidentify, const Eigen::Matrix3d& motion) {
+    LineTrackerOptions options;
+    options.reidentify = reidentify;
+    LineTracker tracker(options, matching);
+    tracker.track(before, 0.0);
+    LineTrackingStats stats;
+    tracker.track(after, 0.1, &stats, motion);
+    return stats;
+  };
+  const LineTrackingStats searched = run(false, Eigen::Matrix3d::Identity());
+  EXPECT_GT(searched.matched, 0) << "horizontal edges slid along themselves";
+  EXPECT_LT(searched.matched, n) << "vertical edges jumped out of the search";
+  EXPECT_EQ(searched.started, n - searched.matched);
+  const LineTrackingStats reidentified = run(true, Eigen::Matrix3d::Identity());
+  EXPECT_EQ(reidentified.matched, n);
+  EXPECT_EQ(reidentified.reidentified, n - searched.matched);
+  const LineTrackingStats predicted = run(true, shift);
+  EXPECT_EQ(predicted.matched, n);
+  EXPECT_EQ(predicted.reidentified, 0);
+}
+
 TEST(LineTracker, NeverTakesAnEdgeOfOppositeContrastAndHandlesEmptyFrames) {
   const LineMatchingOptions matching = video_line_matching_options();
   // A bright bar on dark ground, then the same bar dark on bright ground: the same lines, every

@@ -84,7 +84,7 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
     : options_(options),
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
       klt_(options.klt),
-      line_tracker_(options.line_tracking),
+      line_tracker_(options.line_tracking, options.features.lines),
       vp_tracker_(options.vp_tracker),
       offset_filter_(options.stereo_offset) {}
 
@@ -106,6 +106,7 @@ void VisualOdometry::reset() {
 }
 
 void VisualOdometry::restart() {
+  angular_velocity_.setZero();
   klt_.reset();
   line_tracker_.reset();
   vp_tracker_.reset();
@@ -265,6 +266,16 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
     reset();
     was_reset = true;
   }
+  // The segments move as the camera turns at its last rate; beyond that, by their own motion.
+  Eigen::Matrix3d image_motion = Eigen::Matrix3d::Identity();
+  if (keyframe_.valid && input.stamp > last_stamp_) {
+    const Eigen::Vector3d w = angular_velocity_ * (input.stamp - last_stamp_);
+    if (w.norm() > 0.0) {
+      const Eigen::Matrix3d K = input.camera.pinhole.K();
+      image_motion = K * Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() *
+                     K.inverse();
+    }
+  }
   last_stamp_ = input.stamp;
   const cv::Mat gray = to_gray8(input.image);
   StageTimings& times = r.stages;
@@ -281,7 +292,8 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       const auto lines_start = std::chrono::steady_clock::now();
       features.lines = detect_line_features(gray, options_.features.lines);
       if (options_.track_lines)
-        line_ids = line_tracker_.track(features.lines, input.stamp, &r.line_tracking);
+        line_ids =
+            line_tracker_.track(features.lines, input.stamp, &r.line_tracking, image_motion);
       times.lines_ms = ms_since(lines_start);
     });
   }
@@ -539,6 +551,11 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   if (est.covariance_valid) {
     r.motion_covariance = metric_motion_covariance(est.covariance, pose.t, scale, scale_sigma);
     r.motion_covariance_valid = true;
+  }
+
+  if (input.stamp > keyframe_.stamp) {
+    const Eigen::AngleAxisd turned(est.pose.R);
+    angular_velocity_ = turned.angle() * turned.axis() / (input.stamp - keyframe_.stamp);
   }
 
   // Integrate: the current camera's centre in the keyframe is -R^T t.

@@ -311,9 +311,13 @@ int run(int argc, char** argv) {
     if (verbose) {
       // Per frame: status, VPs and what became of their priors, and the tracks.
       const RelativePoseEstimate& est = r.estimate.estimate;
-      std::printf("frame %d: %s, %d VPs (%d inliers), scales: point %.3f px, line %.3f px, VP "
+      std::printf("frame %d: %s, best %s, %d points (%d inliers), %d lines, %d junctions (%d "
+                  "inliers), %d VPs (%d inliers), scales: point %.3f px, line %.3f px, VP "
                   "%.4f deg (%d)",
-                  i, to_string(r.status), static_cast<int>(r.matches.vps.size()),
+                  i, to_string(r.status), solver_table()[static_cast<int>(est.best_solver)].code,
+                  r.num_point_matches, est.num_point_inliers, r.num_line_matches,
+                  static_cast<int>(est.junctions.size()), est.num_junction_inliers,
+                  static_cast<int>(r.matches.vps.size()),
                   est.num_vp_inliers, est.scales.point_px, est.scales.line_vp_px,
                   est.scales.vp_deg, est.scales.num_vps);
       for (size_t k = 0; k < est.vp_prior_chi2.size(); ++k)

@@ -66,7 +66,7 @@ struct VisualOdometryOptions {
   // barely separate rotation from translation (white panels seen from 2 m: 0.08 deg) from a well
   // conditioned one (KITTI: 0.003 deg), where VPs, with their degree of noise, must not move it.
   bool anchor_orientation = true;
-  double rotation_covariance_scale = 4.0;
+  double rotation_covariance_scale = 2.0;
   double rotation_drift_floor_deg = 0.005;
 };
 
@@ -210,6 +210,9 @@ class VisualOdometry {
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   double last_stamp_ = -1e300;
   bool tracker_seeded_ = false;
+  // The camera's last estimated rotation rate (rad/s, rotation vector of X2 = R X1 per second):
+  // the segments' motion prediction for the next frame.
+  Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace hybrid_vo
