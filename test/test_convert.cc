@@ -33,6 +33,7 @@
 #include "hybrid_vo/conversion/bag_writing.h"
 #include "hybrid_vo/conversion/kitti_to_bag.h"
 #include "hybrid_vo/conversion/lamar_to_bag.h"
+#include "hybrid_vo/frontend/image_codec.h"
 #include "hybrid_vo/render/sequence.h"
 
 namespace hybrid_vo {

@@ -16,6 +16,8 @@
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "hybrid_vo/frontend/image_codec.h"
+
 namespace hybrid_vo {
 namespace conversion {
 
@@ -207,31 +209,6 @@ bool read_mono8(const std::string& path, cv::Mat* mono8, int* channels, std::str
     return failed("cannot decode image (" + e.err + ")");
   }
   return true;
-}
-
-bool jpeg_reaches_end(const std::vector<unsigned char>& b) {
-  const size_t n = b.size();
-  if (n < 4 || b[0] != 0xFF || b[1] != 0xD8) return false;
-  auto standalone = [](unsigned char m) { return m == 0x01 || (m >= 0xD0 && m <= 0xD7); };
-  size_t i = 2;  // after SOI
-  while (i + 1 < n) {
-    if (b[i] != 0xFF) return false;  // no marker where one must be
-    const unsigned char marker = b[i + 1];
-    if (marker == 0xFF) {  // fill byte
-      ++i;
-      continue;
-    }
-    i += 2;
-    if (marker == 0xD9) return true;   // EOI
-    if (standalone(marker)) continue;  // TEM, RSTn: no length
-    if (i + 2 > n) return false;
-    const size_t length = (static_cast<size_t>(b[i]) << 8) | b[i + 1];
-    if (length < 2) return false;
-    i += length;
-    if (marker == 0xDA)  // SOS: entropy-coded data follows, up to the next real marker
-      while (i + 1 < n && !(b[i] == 0xFF && b[i + 1] != 0x00 && !standalone(b[i + 1]))) ++i;
-  }
-  return false;
 }
 
 }  // namespace conversion

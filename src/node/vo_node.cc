@@ -7,12 +7,13 @@
 #include <nav_msgs/Odometry.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "hybrid_vo/node/compressed_image.h"
 #include "hybrid_vo/node/conversions.h"
 
 namespace hybrid_vo {
 
 VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(nh), pnh_(private_nh), it_(nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
+    : nh_(nh), pnh_(private_nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
   load_parameters();
   vo_ = std::make_unique<VisualOdometry>(vo_options_);
   queue_ = std::make_unique<FrameQueue<Frame>>(frame_queue_size_);
@@ -35,8 +36,9 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   reset_service_ = pnh_.advertiseService("reset", &VoNode::reset_callback, this);
   watchdog_timer_ = nh_.createTimer(ros::Duration(0.5), &VoNode::watchdog, this);
   worker_ = std::thread(&VoNode::run, this);
-  ROS_INFO("hybrid_vo: %s, %s sync, preset %s, points %s, lines %s%s%s",
-           stereo_ ? "stereo" : "mono", approximate_sync_ ? "approximate" : "exact",
+  ROS_INFO("hybrid_vo: %s, %s images on %s, %s sync, preset %s, points %s, lines %s%s%s",
+           stereo_ ? "stereo" : "mono", compressed_ ? "compressed" : "raw", image_topic_.c_str(),
+           approximate_sync_ ? "approximate" : "exact",
            pnh_.param<std::string>("preset", "hybrid").c_str(),
            pnh_.param<std::string>("points", "klt").c_str(),
            vo_options_.use_lines ? pnh_.param<std::string>("lines", "fld").c_str() : "none",
@@ -54,6 +56,12 @@ void VoNode::load_parameters() {
   pnh_.param<std::string>("base_frame", base_frame_, "base_link");
   pnh_.param("stereo", stereo_, false);
   pnh_.param("approximate_sync", approximate_sync_, false);
+  // As the standard image_transport parameter, but decoded here: Debian has no plugin for it.
+  const std::string transport = pnh_.param<std::string>("image_transport", "raw");
+  compressed_ = transport == "compressed";
+  if (transport != "raw" && transport != "compressed")
+    ROS_WARN("hybrid_vo: image_transport '%s' unknown (raw or compressed), using 'raw'",
+             transport.c_str());
   pnh_.param("queue_size", queue_size_, 10);
   pnh_.param("publish_tf", publish_tf_, true);
   pnh_.param("feature_points", use_feature_points_, false);
@@ -209,21 +217,33 @@ void VoNode::process(const Frame& frame) {
   latency_ms_.add(latency_ms);
 }
 
+bool VoNode::gray_of(const FrameImage& image, const CameraModel& camera, cv::Mat* gray,
+                     double* decode_ms, std::string* reason) const {
+  if (image.raw) return gray_from_image(image.raw, gray, reason);
+  const auto start = std::chrono::steady_clock::now();
+  const bool ok = gray_from_compressed(*image.compressed, camera.pinhole.width,
+                                       camera.pinhole.height, gray, reason);
+  *decode_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count();
+  return ok;
+}
+
 bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
   input->stamp = frame.stamp.toSec();
   std::string reason;
+  double decode_ms = 0.0;
   if (!camera_from_info(*frame.left_info, &input->camera, &reason))
     return reject("camera_info", reason, &invalid_camera_info_);
-  if (!gray_from_image(frame.left, &input->image, &reason))
+  if (!gray_of(frame.left, input->camera, &input->image, &decode_ms, &reason))
     return reject("image", reason, &bad_images_);
-  if (static_cast<int>(frame.left->width) != input->camera.pinhole.width ||
-      static_cast<int>(frame.left->height) != input->camera.pinhole.height)
+  if (input->image.cols != input->camera.pinhole.width ||
+      input->image.rows != input->camera.pinhole.height)
     return reject("camera_info", "its size differs from the image's", &invalid_camera_info_);
   if (stereo_) {
     CameraModel right;
     if (!camera_from_info(*frame.right_info, &right, &reason))
       return reject("right camera_info", reason, &invalid_camera_info_);
-    if (!gray_from_image(frame.right, &input->right_image, &reason))
+    if (!gray_of(frame.right, right, &input->right_image, &decode_ms, &reason))
       return reject("right image", reason, &bad_images_);
     if (!baseline_from_info(*frame.right_info, &input->baseline_m))
       return reject("right camera_info", "P has no baseline term (P[3] = -fx * B)",
@@ -240,6 +260,10 @@ bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
                                                    &input->external, &reason)
                                  : lines_from_msg(*frame.lines, &input->external, &reason);
     if (!ok) return reject("features/lines", reason, &bad_features_);
+  }
+  if (compressed_) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    decode_ms_.add(decode_ms);
   }
   return true;
 }

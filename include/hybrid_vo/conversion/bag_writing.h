@@ -95,10 +95,5 @@ class BagOutput {
 // converter can refuse a frame unlike the rest of its stream.
 bool read_mono8(const std::string& path, cv::Mat* mono8, int* channels, std::string* error);
 
-// True when JPEG bytes reach their end-of-image marker (bytes after it are allowed): marker
-// segments are skipped by their length, entropy-coded data up to the next marker that is neither
-// a stuffed 0xFF00 nor a restart marker.
-bool jpeg_reaches_end(const std::vector<unsigned char>& bytes);
-
 }  // namespace conversion
 }  // namespace hybrid_vo
