@@ -475,6 +475,12 @@ TEST(RenderOptions, ArgumentsAreParsedAndBadOnesRejected) {
   EXPECT_EQ(o.seed, 7u);
   EXPECT_EQ(o.scene, SceneType::kRoom);
   EXPECT_EQ(o.png_dir, "/tmp/p");
+  SequenceOptions more;
+  EXPECT_EQ(parse_sequence_args({"--out", "x.bag", "--compressed", "jpeg", "--jpeg-quality", "80"},
+                                &more),
+            "");
+  EXPECT_EQ(more.compressed_images, "jpeg");
+  EXPECT_EQ(more.jpeg_quality, 80);
 
   const std::vector<std::vector<std::string>> bad = {
       {},         // no --out
@@ -494,6 +500,8 @@ TEST(RenderOptions, ArgumentsAreParsedAndBadOnesRejected) {
       {"--out", "x.bag", "--supersampling", "0"},
       {"--out", "x.bag", "--compression", "zip"},
       {"--out", "x.bag", "--bogus"},
+      {"--out", "x.bag", "--compressed", "gif"},
+      {"--out", "x.bag", "--jpeg-quality", "101"},
   };
   for (const auto& args : bad) {
     SequenceOptions options;

@@ -4,15 +4,18 @@
 
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 
 #include <cv_bridge/cv_bridge.h>
 #include <Eigen/Geometry>
 #include <geometry_msgs/PoseStamped.h>
 #include <opencv2/imgcodecs.hpp>
 #include <rosbag/exceptions.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -132,13 +135,51 @@ bool BagOutput::commit(std::string* error) {
   return true;
 }
 
+bool parse_compressed_images(const std::string& value, BagImageFormat* format) {
+  if (value == "png") format->kind = BagImageFormat::kPng;
+  else if (value == "jpeg" || value == "jpg") format->kind = BagImageFormat::kJpeg;
+  else return false;
+  return true;
+}
+
+bool parse_jpeg_quality(const std::string& value, BagImageFormat* format) {
+  char* end = nullptr;
+  const long quality = std::strtol(value.c_str(), &end, 10);
+  if (value.empty() || *end || quality < 1 || quality > 100) return false;
+  format->jpeg_quality = static_cast<int>(quality);
+  return true;
+}
+
+const char* to_string(BagImageFormat::Kind kind) {
+  switch (kind) {
+    case BagImageFormat::kPng: return "png";
+    case BagImageFormat::kJpeg: return "jpeg";
+    case BagImageFormat::kRaw: break;
+  }
+  return "raw";
+}
+
 void BagOutput::write_image(const std::string& topic, const std::string& frame,
                             const ros::Time& stamp, const cv::Mat& mono8) {
   std_msgs::Header header;
   header.stamp = stamp;
   header.frame_id = frame;
-  bag_.write(topic, stamp,
-             *cv_bridge::CvImage(header, sensor_msgs::image_encodings::MONO8, mono8).toImageMsg());
+  if (image_format_.kind == BagImageFormat::kRaw) {
+    bag_.write(topic, stamp,
+               *cv_bridge::CvImage(header, sensor_msgs::image_encodings::MONO8, mono8).toImageMsg());
+    return;
+  }
+  sensor_msgs::CompressedImage image;
+  image.header = header;
+  const bool png = image_format_.kind == BagImageFormat::kPng;
+  // compressed_image_transport's format field: "<encoding>; <codec> compressed [<target>]".
+  image.format = png ? "mono8; png compressed " : "mono8; jpeg compressed mono8";
+  const std::vector<int> params =
+      png ? std::vector<int>{} : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, image_format_.jpeg_quality};
+  if (!cv::imencode(png ? ".png" : ".jpg", mono8, image.data, params))
+    throw std::runtime_error(std::string("cannot encode ") + to_string(image_format_.kind) +
+                             " for " + topic);
+  bag_.write(topic + "/compressed", stamp, image);
 }
 
 void BagOutput::write_ground_truth(const std::string& child, const ros::Time& stamp,

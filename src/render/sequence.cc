@@ -64,6 +64,8 @@ std::string sequence_usage(const std::string& program) {
     << "  --noise SIGMA      image noise in grey levels (default 1)\n"
     << "  --supersampling K  K x K rays per pixel (default 3)\n"
     << "  --compression none|lz4|bz2  bag compression (default lz4)\n"
+    << "  --compressed png|jpeg  images as sensor_msgs/CompressedImage on .../image_raw/compressed\n"
+    << "  --jpeg-quality Q   with --compressed jpeg: quality 1..100 (default 95)\n"
     << "  --png-dir DIR      also write the images as PNG files\n";
   return s.str();
 }
@@ -82,7 +84,8 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     static const char* kValued[] = {"--out",           "--png-dir",    "--frames", "--width",
                                     "--height",        "--rate",       "--seed",   "--scene",
                                     "--baseline",      "--speed",      "--focal",  "--noise",
-                                    "--supersampling", "--compression", "--laps"};
+                                    "--supersampling", "--compression", "--laps",
+                                    "--compressed",    "--jpeg-quality"};
     bool known = false;
     for (const char* name : kValued) known = known || arg == name;
     if (!known) return "unknown argument '" + arg + "'";
@@ -122,6 +125,11 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     } else if (arg == "--compression") {
       o->compression = v;
       ok = v == "none" || v == "lz4" || v == "bz2";
+    } else if (arg == "--compressed") {
+      o->compressed_images = v;
+      ok = v == "png" || v == "jpeg";
+    } else if (arg == "--jpeg-quality") {
+      ok = parse_int(v, 1, 100, &o->jpeg_quality);
     }
     if (!ok) return "bad value '" + v + "' for " + arg;
   }

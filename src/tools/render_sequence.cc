@@ -69,6 +69,11 @@ int main(int argc, char** argv) {
       std::cerr << "error: cannot write the bag: " << bag_error << "\n";
       return 1;
     }
+    conversion::BagImageFormat images;
+    if (!options.compressed_images.empty())
+      conversion::parse_compressed_images(options.compressed_images, &images);  // checked
+    images.jpeg_quality = options.jpeg_quality;
+    out.set_image_format(images);
     const std::string left = conversion::optical_frame("left");
     const std::string right = conversion::optical_frame("right");
 

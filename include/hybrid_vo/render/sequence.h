@@ -34,6 +34,8 @@ struct SequenceOptions {
   double noise = 1.0;      // grey levels
   int supersampling = 3;
   std::string compression = "lz4";  // none, lz4 or bz2
+  std::string compressed_images;    // empty: raw images; png or jpeg: CompressedImage topics
+  int jpeg_quality = 95;
   bool help = false;
 };
 
