@@ -1,6 +1,7 @@
 #include "hybrid_vo/node/vo_node.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include <hybrid_vo/MotionEstimate.h>
 #include <hybrid_vo/VanishingPoints.h>
@@ -11,6 +12,33 @@
 #include "hybrid_vo/node/conversions.h"
 
 namespace hybrid_vo {
+namespace {
+
+// For diagnostics: camera_info's model and coefficients, and the pinhole view when the node
+// rectified the image into one.
+std::string describe_camera(const sensor_msgs::CameraInfo& info, const CameraModel& lens,
+                            const CameraModel& used) {
+  const std::string model = info.distortion_model.empty() ? "none" : info.distortion_model;
+  char text[200];
+  if (lens.model != LensModel::kEquidistant) {
+    std::snprintf(text, sizeof(text), "%s%s", model.c_str(),
+                  lens.has_distortion() ? " (features undistorted)" : " (no distortion)");
+  } else if (used.model == LensModel::kEquidistant) {
+    std::snprintf(text, sizeof(text),
+                  "equidistant k1..k4 = %.4g %.4g %.4g %.4g (features undistorted, not rectified)",
+                  lens.distortion[0], lens.distortion[1], lens.distortion[2], lens.distortion[3]);
+  } else {
+    const PinholeCamera& p = used.pinhole;
+    std::snprintf(text, sizeof(text),
+                  "equidistant k1..k4 = %.4g %.4g %.4g %.4g, rectified to a pinhole view of "
+                  "%.0f deg horizontal (f %.1f px)",
+                  lens.distortion[0], lens.distortion[1], lens.distortion[2], lens.distortion[3],
+                  2.0 * std::atan(0.5 * p.width / p.fx) * 180.0 / M_PI, p.fx);
+  }
+  return text;
+}
+
+}  // namespace
 
 VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), pnh_(private_nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
@@ -56,6 +84,13 @@ void VoNode::load_parameters() {
   pnh_.param<std::string>("base_frame", base_frame_, "base_link");
   pnh_.param("stereo", stereo_, false);
   pnh_.param("approximate_sync", approximate_sync_, false);
+  pnh_.param("rectify_fisheye", rectify_fisheye_, true);
+  double fov_deg = pnh_.param("rectified_fov_deg", 100.0);
+  if (!(fov_deg >= 10.0 && fov_deg <= 170.0)) {
+    ROS_WARN("hybrid_vo: rectified_fov_deg must be in [10, 170], using 100");
+    fov_deg = 100.0;
+  }
+  left_rectifier_ = right_rectifier_ = FisheyeRectifier(fov_deg);
   // As the standard image_transport parameter, but decoded here: Debian has no plugin for it.
   const std::string transport = pnh_.param<std::string>("image_transport", "raw");
   compressed_ = transport == "compressed";
@@ -228,6 +263,20 @@ bool VoNode::gray_of(const FrameImage& image, const CameraModel& camera, cv::Mat
   return ok;
 }
 
+bool VoNode::rectify(const sensor_msgs::CameraInfo& info, FisheyeRectifier* rectifier,
+                     CameraModel* camera, cv::Mat* image, std::string* reason) {
+  if (camera->model != LensModel::kEquidistant || !rectify_fisheye_) return true;
+  Eigen::Matrix3d R;
+  if (!rectification_from_info(info, &R)) {
+    *reason = "R is not a rotation matrix";
+    return false;
+  }
+  cv::Mat rectified;
+  if (!rectifier->rectify(*camera, R, *image, &rectified, camera, reason)) return false;
+  *image = rectified;
+  return true;
+}
+
 bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
   input->stamp = frame.stamp.toSec();
   std::string reason;
@@ -239,12 +288,17 @@ bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
   if (input->image.cols != input->camera.pinhole.width ||
       input->image.rows != input->camera.pinhole.height)
     return reject("camera_info", "its size differs from the image's", &invalid_camera_info_);
+  const CameraModel lens = input->camera;
+  if (!rectify(*frame.left_info, &left_rectifier_, &input->camera, &input->image, &reason))
+    return reject("camera_info", reason, &invalid_camera_info_);
   if (stereo_) {
     CameraModel right;
     if (!camera_from_info(*frame.right_info, &right, &reason))
       return reject("right camera_info", reason, &invalid_camera_info_);
     if (!gray_of(frame.right, right, &input->right_image, &decode_ms, &reason))
       return reject("right image", reason, &bad_images_);
+    if (!rectify(*frame.right_info, &right_rectifier_, &right, &input->right_image, &reason))
+      return reject("right camera_info", reason, &invalid_camera_info_);
     if (!baseline_from_info(*frame.right_info, &input->baseline_m))
       return reject("right camera_info", "P has no baseline term (P[3] = -fx * B)",
                     &invalid_camera_info_);
@@ -261,10 +315,9 @@ bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
                                  : lines_from_msg(*frame.lines, &input->external, &reason);
     if (!ok) return reject("features/lines", reason, &bad_features_);
   }
-  if (compressed_) {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    decode_ms_.add(decode_ms);
-  }
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  if (compressed_) decode_ms_.add(decode_ms);
+  camera_model_ = describe_camera(*frame.left_info, lens, input->camera);
   return true;
 }
 

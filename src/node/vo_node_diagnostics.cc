@@ -77,6 +77,7 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
 void VoNode::add_input(diagnostic_updater::DiagnosticStatusWrapper& status) const {
   status.add("image topic", image_topic_);
   status.add("image transport", compressed_ ? "compressed (decoded by the node)" : "raw");
+  status.add("camera model", camera_model_.empty() ? "no frame yet" : camera_model_);
   if (compressed_) {
     // Per frame (both images in stereo), from the last 200 frames.
     status.add("image decode p50 (ms)", decode_ms_.quantile(0.5));

@@ -31,6 +31,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/Marker.h>
 
+#include "hybrid_vo/frontend/fisheye_rectifier.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/node/frame_queue.h"
 #include "hybrid_vo/node/latency_window.h"
@@ -83,6 +84,10 @@ class VoNode {
   // and its decoding time added to *decode_ms.
   bool gray_of(const FrameImage& image, const CameraModel& camera, cv::Mat* gray,
                double* decode_ms, std::string* reason) const;
+  // An equidistant camera's image rectified into the pinhole view (rectify_fisheye), its camera
+  // replaced by the view's; other cameras and images are left as they are.
+  bool rectify(const sensor_msgs::CameraInfo& info, FisheyeRectifier* rectifier,
+               CameraModel* camera, cv::Mat* image, std::string* reason);
   // The frame's outcome for the diagnostics.
   void record_result(const Frame& frame, const VisualOdometryResult& result, bool lost);
   // Resets or restarts the odometry for a fault in the stream (a valid frame of this stamp and
@@ -163,6 +168,7 @@ class VoNode {
   std::string odom_frame_, base_frame_;
   bool stereo_ = false, approximate_sync_ = false, publish_tf_ = true;
   bool compressed_ = false;  // image_transport: compressed
+  bool rectify_fisheye_ = true;
   bool use_feature_points_ = false, use_feature_lines_ = false, vins_format_ = false;
   bool publish_debug_image_ = true, publish_markers_ = true;
   int queue_size_ = 10;
@@ -201,6 +207,8 @@ class VoNode {
   // touches the odometry and the publishers' state.
   std::mutex process_mutex_;
   std::unique_ptr<VisualOdometry> vo_;
+  // Per camera: the remap tables of the last equidistant camera_info.
+  FisheyeRectifier left_rectifier_, right_rectifier_;
   StreamMonitor monitor_;
   bool have_base_transform_ = false, looked_up_base_ = false;
   Eigen::Matrix3d R_base_camera_ = Eigen::Matrix3d::Identity();
@@ -219,6 +227,7 @@ class VoNode {
   ros::Time last_processed_;
   VisualOdometryResult last_result_;
   std::string last_problem_;
+  std::string camera_model_;  // the last frame's lens model and what the node made of it
   int frames_ = 0, invalid_camera_info_ = 0, bad_images_ = 0, failures_ = 0, dropped_ = 0,
       bad_features_ = 0, camera_info_outages_ = 0;
   bool camera_info_outage_ = false;
