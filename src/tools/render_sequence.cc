@@ -2,6 +2,7 @@
 // bag with images, camera_info, ground-truth poses and tf; the demo's default data and the
 // rostest fixture.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -103,9 +104,13 @@ int main(int argc, char** argv) {
         const std::string prefix = conversion::camera_topic(is_right ? "right" : "left");
         const std::string& frame = is_right ? right : left;
         out.write_image(prefix + "/image_raw", frame, t, view.image);
-        out.bag().write(
-            prefix + "/camera_info", t,
-            conversion::make_camera_info(seq.camera, frame, t, is_right ? tx_right : 0.0));
+        out.bag().write(prefix + "/camera_info", t,
+                        seq.lens.model == hybrid_vo::LensModel::kEquidistant
+                            ? conversion::make_camera_info(
+                                  seq.camera, frame, t, is_right ? tx_right : 0.0, "equidistant",
+                                  {seq.lens.distortion.begin(), seq.lens.distortion.begin() + 4})
+                            : conversion::make_camera_info(seq.camera, frame, t,
+                                                           is_right ? tx_right : 0.0));
         if (!options.png_dir.empty()) {
           char name[64];
           std::snprintf(name, sizeof(name), "%s_%06d.png", is_right ? "right" : "left", i);
@@ -128,9 +133,13 @@ int main(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const int views = seq.options.frames * (options.stereo ? 2 : 1);
     std::printf(
-        "rendered %d frames (%s, %dx%d, %s, %.0f Hz), path %.1f m, turned %.0f deg, "
+        "rendered %d frames (%s, %dx%d, %s%s, %.0f Hz), path %.1f m, turned %.0f deg, "
         "%.3f s per view, %.1f s total -> %s\n",
         seq.options.frames, options.stereo ? "stereo" : "mono", options.width, options.height,
+        options.fisheye_fov > 0.0
+            ? (std::to_string(static_cast<int>(std::lround(options.fisheye_fov))) +
+               " deg equidistant, ").c_str()
+            : "",
         to_string(options.scene), options.rate, seq.trajectory.length,
         seq.trajectory.total_turn_deg, render_seconds / views, total, options.out_bag.c_str());
   } catch (const rosbag::BagException& e) {
