@@ -6,13 +6,16 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <string>
 #include <stdexcept>
 #include <tuple>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "hybrid_vo/estimation/relative_pose_estimator.h"
 #include "hybrid_vo/frontend/klt_tracker.h"
 #include "hybrid_vo/frontend/line_tracker.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
@@ -323,6 +326,54 @@ TEST(KltTracker, StampsCarryThePredictionOverADroppedFrame) {
   // One step short is beyond the short search's reach for most features; what the long search
   // recovers is not enough.
   EXPECT_GT(correct_with, correct_without + with / 10) << correct_without << " of " << without;
+}
+
+// Issue 30: the rendered corridor with plain walls (only edges, corners and floor joints;
+// points find sensor noise). Each estimated pair's rotation error against the renderer's truth,
+// for a preset, in degrees.
+std::vector<double> plain_corridor_rotation_errors(const std::string& preset, int frames) {
+  SequenceOptions options;
+  options.out_bag = "unused.bag";
+  options.frames = frames;
+  options.supersampling = 1;
+  options.texture = TextureStyle::kPlain;
+  const Sequence seq = make_sequence(options);
+  VisualOdometryOptions vo_options;
+  EXPECT_TRUE(preset_options(preset, &vo_options.estimator.estimator));
+  VisualOdometry vo(vo_options);
+  std::vector<double> errors;
+  for (int i = 0; i < frames; ++i) {
+    VisualOdometryInput in;
+    in.stamp = 1.0 + i / seq.options.rate;
+    in.image = render_frame(seq, i).image;
+    in.camera.pinhole = seq.camera;
+    const VisualOdometryResult r = vo.process(in);
+    if (r.status != VoStatus::kOk) continue;
+    const int ref = static_cast<int>(std::lround((r.reference_stamp - 1.0) * seq.options.rate));
+    const CameraPose a = frame_pose(seq, ref), b = frame_pose(seq, i);
+    const Eigen::Matrix3d R = b.R_world_from_camera.transpose() * a.R_world_from_camera;
+    errors.push_back(Eigen::AngleAxisd(r.motion.R * R.transpose()).angle() * 180.0 / M_PI);
+  }
+  return errors;
+}
+
+double median_of(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+TEST(LowTexture, LinesHalveTheRotationErrorOnPlainWalls) {
+  constexpr int kPlainFrames = 60;  // along a corridor and through its first corner
+  const std::vector<double> points = plain_corridor_rotation_errors("5pc", kPlainFrames);
+  const std::vector<double> lines = plain_corridor_rotation_errors("hybrid+junc", kPlainFrames);
+  ASSERT_GE(points.size(), kPlainFrames / 2u);
+  ASSERT_GE(lines.size(), kPlainFrames / 2u);
+  const double with_points = median_of(points), with_lines = median_of(lines);
+  std::printf("median rotation error per pair: 5pc %.3f deg (%zu pairs), hybrid+junc %.3f deg "
+              "(%zu pairs)\n",
+              with_points, points.size(), with_lines, lines.size());
+  EXPECT_LE(with_lines, 0.5 * with_points);
+  EXPECT_LE(with_lines, 0.3);
 }
 
 // A synthetic scene of a bright and a grey rectangle, shifted `shift` pixels to the right.
