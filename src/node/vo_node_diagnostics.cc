@@ -97,6 +97,12 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("line matches", r.num_line_matches);
   status.add("line inliers", est.num_line_inliers);
   status.add("VP inliers", est.num_vp_inliers);
+  status.add("junction inliers", est.num_junction_inliers);
+  // Orientation anchoring: how many VP tracks corrected this frame's orientation, by how much,
+  // and how many disagreed beyond the gate.
+  status.add("orientation anchors", r.anchoring.anchors);
+  status.add("orientation anchors rejected", r.anchoring.rejected);
+  status.add("orientation correction (deg)", r.anchoring.correction_deg);
   status.add("scale known", r.scale_known);
   if (r.stereo_scale_attempted) {
     status.add("stereo scale", to_string(r.stereo_scale.status));
