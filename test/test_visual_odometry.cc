@@ -339,7 +339,7 @@ std::vector<double> plain_corridor_rotation_errors(const std::string& preset, in
   options.texture = TextureStyle::kPlain;
   const Sequence seq = make_sequence(options);
   VisualOdometryOptions vo_options;
-  EXPECT_TRUE(preset_options(preset, &vo_options.estimator.estimator));
+  EXPECT_TRUE(preset_options(preset, &vo_options.estimator));
   VisualOdometry vo(vo_options);
   std::vector<double> errors;
   for (int i = 0; i < frames; ++i) {
@@ -509,11 +509,10 @@ TEST(KltTracker, FaintTextureIsNotTrackedStrongCornersAre) {
   for (int k = 0; k < 4; ++k)  // four dark squares: 16 strong corners
     cv::rectangle(image, cv::Rect(40 + 60 * k, 100, 30, 30), cv::Scalar(60), cv::FILLED);
   KltTrackerOptions options;
-  options.max_features = 300;
-  KltTracker all(options);
+  KltTracker all(options, 300);
   all.track(image);
   options.min_corner_gradient = 1.5;
-  KltTracker strong(options);
+  KltTracker strong(options, 300);
   strong.track(image);
   EXPECT_GT(all.num_tracks(), 60) << "every cell finds its faint corners";
   EXPECT_GE(strong.num_tracks(), 12);

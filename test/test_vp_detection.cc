@@ -300,7 +300,7 @@ TEST(TwoView, DetectsVpsWhenNoneAreGiven) {
   EXPECT_LT(rotation_error(result.estimate.pose.R, s.truth.R) * 180.0 / M_PI, 0.3);
   // A point-only preset never detects.
   TwoViewOptions points_only;
-  preset_options("5pc", &points_only.estimator);
+  preset_options("5pc", &points_only);
   EXPECT_FALSE(estimate_two_view(s.camera1, s.camera2, s.matches, points_only).vps_detected);
 }
 

@@ -23,8 +23,6 @@ import sys as _sys
 
 from . import _core
 from ._core import (  # noqa: F401  (re-exported)
-    RelativePoseEstimate,
-    estimate_relative_pose,
     estimator_options,
     pose_error_deg,
     presets,
@@ -50,6 +48,102 @@ from ._core import (  # noqa: F401  (re-exported)
 
 # The generators live in the extension as a submodule; make `import hybrid_vo.synthetic` work.
 _sys.modules[__name__ + ".synthetic"] = synthetic
+
+
+class RelativePoseEstimate:
+    """Result of estimate_relative_pose. The pose maps camera-1 to camera-2 coordinates,
+    X2 = R X1 + t, with unit t. Masks are NumPy bool arrays aligned with the inputs."""
+
+    __slots__ = ("_fields",)
+
+    def __init__(self, fields):
+        self._fields = fields
+
+    def __repr__(self):
+        f = self._fields
+        return (f"<RelativePoseEstimate status='{f['status']}': {f['num_point_inliers']} point, "
+                f"{f['num_junction_inliers']} junction, {f['num_line_inliers']} line, "
+                f"{f['num_vp_inliers']} VP inliers; best solver {f['best_solver'] or '-'}; "
+                f"{f['iterations']} iterations; {f['timings']['total_ms']:.2f} ms>")
+
+
+# The result's fields, each a read-only property with its docstring.
+_ESTIMATE_FIELDS = {
+    "status": "'ok', 'invalid input', 'too little data', 'degenerate' or 'no model'.",
+    "ok": "status == 'ok'.",
+    "R": "3 x 3 rotation, or None when status is not 'ok'.",
+    "t": "Unit translation (3,), or None when status is not 'ok'.",
+    "covariance": "6 x 6 covariance of [w, t] after the final refinement: w (radians) the left "
+                  "rotation increment R <- exp([w]x) R, t the unit translation (rank 5). None "
+                  "when not available.",
+    "point_inliers": "Per point match (points1/points2).",
+    "line_inliers": "Per segment match: it meets another at an inlier junction, or agrees with "
+                    "the rotation through its VP.",
+    "vp_inliers": "Per VP match (given, or detected: see vps).",
+    "junction_inliers": "Per junction (see junctions).",
+    "endpoint_inliers": "Per segment endpoint match (see endpoints).",
+    "num_point_inliers": "Number of point inliers.",
+    "num_line_inliers": "Number of line inliers.",
+    "num_vp_inliers": "Number of VP inliers.",
+    "num_junction_inliers": "Number of junction inliers.",
+    "num_endpoint_inliers": "Number of endpoint inliers.",
+    "junctions": "J x 4 junction matches in pixels (x1, y1, x2, y2), from segment pairs that "
+                 "intersect in both images.",
+    "junction_segments": "J x 2: the two segment matches of each junction.",
+    "endpoints": "E x 4 endpoint matches in pixels (only with use_endpoint_points).",
+    "endpoint_segments": "E x 2: segment index and which end (0 or 1).",
+    "vps": "(directions1, directions2): the K x 3 VP matches used, given or detected.",
+    "vp_signs_known": "Per VP match: d2 = +R d1 known (else +-R d1).",
+    "line_vp": "Per segment match: index of its VP in vps, or -1 (empty without labels).",
+    "vps_detected": "True when the VPs were detected from the segments.",
+    "solver_statistics": "Per solver (function name): its paper code, how often it was drawn "
+                         "('sampled'), poses it produced ('models') and how often one became "
+                         "the best model ('best').",
+    "best_solver": "Function name of the solver behind the best model, or None.",
+    "iterations": "RANSAC iterations.",
+    "local_optimizations": "Local optimisations of new best models.",
+    "refined": "True when the final Ceres refinement was kept.",
+    "rejected": "Inputs skipped as invalid (zero-length segments, ...), per modality.",
+    "timings": "Milliseconds: VP detection, derived data (junctions), RANSAC, final refinement, "
+               "the whole estimator, and VP detection plus estimator.",
+}
+for _name, _doc in _ESTIMATE_FIELDS.items():
+    setattr(RelativePoseEstimate, _name,
+            property(lambda self, _name=_name: self._fields[_name], doc=_doc))
+
+
+def estimate_relative_pose(camera1, camera2, points1, points2, segments1=None, segments2=None,
+                           vps=None, preset="hybrid+junc", *, line_vp=None, vp_signs_known=None,
+                           **options):
+    """Relative pose between two calibrated views from point, segment and VP matches: the hybrid
+    RANSAC over the minimal solvers with Ceres refinement (paper Sec. 4), with VP detection in
+    front when segments but no VPs are given and a VP solver is enabled.
+
+    camera1, camera2: {'fx', 'fy', 'cx', 'cy'[, 'width', 'height']} or (fx, fy, cx, cy).
+    points1, points2: N x 2 undistorted pixels (float64, C-contiguous), row i of each a match;
+        None for none.
+    segments1, segments2: M x 4 segment matches in pixels (x1, y1, x2, y2); endpoints need not
+        correspond.
+    vps: (directions1, directions2), K x 3 VP matches as directions K^-1 v (any scale, either
+        sign). None: detected from the segments (joint two-view detection) when a VP solver is
+        enabled.
+    preset: '5pc', '5pc+junc', '5pc+4pc', '5pc+4pc+junc', 'hybrid' or 'hybrid+junc' (the
+        paper's rows); the options below override it.
+    line_vp: per segment match, the index of its VP in vps or -1 (labels for the refinement).
+    vp_signs_known: bool, or one per VP: d2 = +R d1 is known (else both signs are tried).
+    **options: the estimator's option fields by name, e.g. point_threshold_px=1.0, seed=0,
+        min_iterations=150, enabled={'relpose_2vp_2pt': False}; estimator_options() lists every
+        name with its default. Unknown names raise ValueError; renamed ones (final_refinement:
+        refinement_enabled) still work, with a DeprecationWarning.
+
+    Returns a RelativePoseEstimate: R, t (None unless status == 'ok'), covariance, inlier masks
+    per modality, junctions, the VPs used, per-solver statistics, iterations and timings.
+    Raises ValueError for malformed input (shapes, dtypes, strides, NaN, unknown options); data
+    the estimator cannot use gives a status instead.
+    """
+    return RelativePoseEstimate(_core._estimate_relative_pose(
+        camera1, camera2, points1, points2, segments1, segments2, vps, preset, line_vp=line_vp,
+        vp_signs_known=vp_signs_known, **options))
 
 
 def detect_vanishing_points(*args, mode="joint", **options):

@@ -386,7 +386,7 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
     return finish(EstimationStatus::kNoModel);
 
   est.scales = measure_scales(problem, scorer, options, matches, est.pose);
-  if (options.final_refinement) {
+  if (options.refinement.enabled) {
     const auto refine_start = std::chrono::steady_clock::now();
     refine_final(problem, scorer, options, matches, &est);
     est.refine_ms = ms_since(refine_start);

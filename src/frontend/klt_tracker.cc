@@ -58,7 +58,8 @@ double corner_gradient(const cv::Mat& gray, const cv::Point2f& p, int window) {
 
 }  // namespace
 
-KltTracker::KltTracker(const KltTrackerOptions& options) : options_(options) {}
+KltTracker::KltTracker(const KltTrackerOptions& options, int max_features)
+    : options_(options), max_features_(max_features) {}
 
 void KltTracker::reset() {
   previous_.clear();
@@ -210,7 +211,7 @@ void KltTracker::detect_new() {
   // textured object makes a poorly conditioned relative pose). With fewer features than cells
   // the grid gets coarser, so that every cell has a quota of at least one and max_features stays
   // a cap: the features, and so the matches that reach the estimator, never exceed it.
-  const int max_features = std::max(1, options_.max_features);
+  const int max_features = std::max(1, max_features_);
   int cols = std::max(1, options_.grid_cols), rows = std::max(1, options_.grid_rows);
   while (cols * rows > max_features && (cols > 1 || rows > 1)) {
     if (cols >= rows) --cols;

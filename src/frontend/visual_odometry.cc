@@ -53,7 +53,7 @@ VisualOdometryOptions::VisualOdometryOptions() {
   // segments that stop short of a corner still meet.
   estimator.vp_detection.min_long_inliers = 3;
   estimator.vp_detection.min_support_px = 150.0;
-  estimator.estimator.junctions.length_fraction = 0.15;
+  estimator.junctions.length_fraction = 0.15;
   // A scene direction does not go away: a track survives a few seconds unseen, and is not dropped
   // for disagreeing with the odometry, which is what it exists to correct (anchor_orientation).
   vp_tracker.max_misses = 60;
@@ -83,7 +83,7 @@ const char* to_string(VoStatus status) {
 VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
     : options_(options),
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
-      klt_(options.klt),
+      klt_(options.klt, options.features.points.max_features),
       line_tracker_(options.line_tracking, options.features.lines),
       vp_tracker_(options.vp_tracker),
       offset_filter_(options.stereo_offset) {}
@@ -436,7 +436,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   }
   TwoViewOptions estimator = options_.estimator;
   const auto vps_start = std::chrono::steady_clock::now();
-  if (uses_vps(estimator.estimator) && !m.lines.empty()) {
+  if (uses_vps(estimator) && !m.lines.empty()) {
     VpDetectionOptions vp_options = estimator.vp_detection;
     const MatchedVps vps = estimator.joint_vp_detection
                                ? detect_vanishing_points_joint(keyframe_.camera.pinhole,
@@ -453,7 +453,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
                            vp_observations(keyframe_.camera.pinhole.K(), m, false,
                                            options_.estimator.vp_detection.inlier_threshold_px /
                                                3.0,
-                                           options_.estimator.estimator.ransac.vp_threshold_deg /
+                                           options_.estimator.ransac.vp_threshold_deg /
                                                3.0));
         tracker_seeded_ = true;
       }

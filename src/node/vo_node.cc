@@ -43,8 +43,8 @@ std::string describe_camera(const sensor_msgs::CameraInfo& info, const CameraMod
 VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), pnh_(private_nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
   load_parameters();
-  vo_ = std::make_unique<VisualOdometry>(vo_options_);
-  queue_ = std::make_unique<FrameQueue<Frame>>(frame_queue_size_);
+  vo_ = std::make_unique<VisualOdometry>(params_.odometry);
+  queue_ = std::make_unique<FrameQueue<Frame>>(params_.frame_queue_size);
 
   relative_pose_pub_ = pnh_.advertise<MotionEstimate>("relative_pose", 10);
   odometry_pub_ = pnh_.advertise<nav_msgs::Odometry>("odometry", 10);
@@ -56,7 +56,7 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
 
   updater_.setHardwareID("hybrid_vo");
   frequency_ = std::make_unique<diagnostic_updater::FrequencyStatus>(
-      diagnostic_updater::FrequencyStatusParam(&min_frequency_, &max_frequency_, 0.1, 10));
+      diagnostic_updater::FrequencyStatusParam(&params_.min_frequency, &params_.max_frequency, 0.1, 10));
   updater_.add(*frequency_);
   updater_.add("odometry", this, &VoNode::diagnose);
 
@@ -65,13 +65,12 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   watchdog_timer_ = nh_.createTimer(ros::Duration(0.5), &VoNode::watchdog, this);
   worker_ = std::thread(&VoNode::run, this);
   ROS_INFO("hybrid_vo: %s, %s images on %s, %s sync, preset %s, points %s, lines %s%s%s",
-           stereo_ ? "stereo" : "mono", compressed_ ? "compressed" : "raw", image_topic_.c_str(),
-           approximate_sync_ ? "approximate" : "exact",
-           pnh_.param<std::string>("preset", "hybrid").c_str(),
-           pnh_.param<std::string>("points", "klt").c_str(),
-           vo_options_.use_lines ? pnh_.param<std::string>("lines", "fld").c_str() : "none",
-           use_feature_points_ ? ", point features from features/points" : "",
-           use_feature_lines_ ? ", line features from features/lines" : "");
+           params_.stereo ? "stereo" : "mono", params_.compressed ? "compressed" : "raw", image_topic_.c_str(),
+           params_.approximate_sync ? "approximate" : "exact",
+           params_.preset.c_str(), params_.points.c_str(),
+           params_.odometry.use_lines ? params_.lines.c_str() : "none",
+           params_.feature_points ? ", point features from features/points" : "",
+           params_.feature_lines ? ", line features from features/lines" : "");
 }
 
 VoNode::~VoNode() {
@@ -80,101 +79,13 @@ VoNode::~VoNode() {
 }
 
 void VoNode::load_parameters() {
-  pnh_.param<std::string>("odom_frame", odom_frame_, "odom");
-  pnh_.param<std::string>("base_frame", base_frame_, "base_link");
-  pnh_.param("stereo", stereo_, false);
-  pnh_.param("approximate_sync", approximate_sync_, false);
-  pnh_.param("rectify_fisheye", rectify_fisheye_, true);
-  double fov_deg = pnh_.param("rectified_fov_deg", 100.0);
-  if (!(fov_deg >= 10.0 && fov_deg <= 170.0)) {
-    ROS_WARN("hybrid_vo: rectified_fov_deg must be in [10, 170], using 100");
-    fov_deg = 100.0;
-  }
-  left_rectifier_ = right_rectifier_ = FisheyeRectifier(fov_deg);
-  // As the standard image_transport parameter, but decoded here: Debian has no plugin for it.
-  const std::string transport = pnh_.param<std::string>("image_transport", "raw");
-  compressed_ = transport == "compressed";
-  if (transport != "raw" && transport != "compressed")
-    ROS_WARN("hybrid_vo: image_transport '%s' unknown (raw or compressed), using 'raw'",
-             transport.c_str());
-  pnh_.param("queue_size", queue_size_, 10);
-  pnh_.param("publish_tf", publish_tf_, true);
-  pnh_.param("feature_points", use_feature_points_, false);
-  pnh_.param("feature_lines", use_feature_lines_, false);
-  pnh_.param("publish_debug_image", publish_debug_image_, true);
-  pnh_.param("publish_markers", publish_markers_, true);
-  pnh_.param("camera_info_timeout", camera_info_timeout_, 2.0);
-  pnh_.param("min_frequency", min_frequency_, 1.0);
-  pnh_.param("max_frequency", max_frequency_, 100.0);
-  const std::string format = pnh_.param<std::string>("feature_format", "native");
-  vins_format_ = format == "vins";
-  if (format != "native" && format != "vins")
-    ROS_WARN("hybrid_vo: feature_format '%s' unknown, using 'native'", format.c_str());
-  if (queue_size_ < 1) queue_size_ = 1;
-  pnh_.param("frame_queue_size", frame_queue_size_, 1);
-  if (frame_queue_size_ < 1) {
-    ROS_WARN("hybrid_vo: frame_queue_size must be >= 1, using 1");
-    frame_queue_size_ = 1;
-  }
-  pnh_.param("path_max_poses", path_max_poses_, 5000);
-  StreamMonitorOptions stream;
-  pnh_.param("max_frame_gap", stream.max_gap_s, 1.0);
-  if (!(stream.max_gap_s > 0.0)) {
-    ROS_WARN("hybrid_vo: max_frame_gap must be > 0 s, using 1");
-    stream.max_gap_s = 1.0;
-  }
-  monitor_ = StreamMonitor(stream);
-  load_odometry_options();
-}
-
-void VoNode::load_odometry_options() {
-  VisualOdometryOptions& o = vo_options_;
-  const std::string preset = pnh_.param<std::string>("preset", "hybrid");
-  if (!preset_options(preset, &o.estimator.estimator)) {
-    ROS_WARN("hybrid_vo: unknown preset '%s', using 'hybrid'", preset.c_str());
-    preset_options("hybrid", &o.estimator.estimator);
-  }
-  const std::string points = pnh_.param<std::string>("points", "klt");
-  if (points == "sift" || points == "orb") {
-    o.point_source = PointFeatureSource::kDescriptors;
-    o.features.points.type = points == "orb" ? PointFeatureType::kOrb : PointFeatureType::kSift;
-  } else if (points != "klt") {
-    ROS_WARN("hybrid_vo: points '%s' unknown, using 'klt'", points.c_str());
-  }
-  const std::string lines = pnh_.param<std::string>("lines", "fld");
-  o.use_lines = lines != "none";
-  if (lines == "lsd") o.features.lines.detection.detector = LineDetector::kLsd;
-  else if (lines != "fld" && lines != "none")
-    ROS_WARN("hybrid_vo: lines '%s' unknown, using 'fld'", lines.c_str());
-  o.klt.max_features = pnh_.param("max_features", 1000);
-  o.features.points.max_features = o.klt.max_features;
-  o.min_parallax_px = pnh_.param("min_parallax_px", 2.0);
-  o.mono_scale = pnh_.param("mono_scale", 1.0);
-  o.stereo_scale.max_depth_baselines =
-      pnh_.param("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines);
-  o.stereo_offset.enabled = pnh_.param("stereo_offset_calibration", o.stereo_offset.enabled);
-  o.stereo_refine_tracks = pnh_.param("stereo_refine_tracks", o.stereo_refine_tracks);
-  o.estimator.estimator.ransac.point_threshold_px = pnh_.param("point_threshold_px", 1.0);
-  o.estimator.estimator.ransac.vp_threshold_deg = pnh_.param("vp_threshold_deg", 2.0);
-  o.estimator.vp_detection.inlier_threshold_px = pnh_.param("vp_inlier_threshold_px", 2.0);
-  // 6, not the pair tools' 15: the video front end's FLD segments are fewer and shorter, and the
-  // VP tracker already keeps only VPs that persist (KITTI and demo AUC@10 +1.5 and +1.2 at 6).
-  o.estimator.vp_detection.min_inliers = pnh_.param("vp_min_inliers", 6);
-  if (o.estimator.vp_detection.min_inliers < 2) {
-    ROS_WARN("hybrid_vo: vp_min_inliers must be >= 2 (a VP needs two segments), using 6");
-    o.estimator.vp_detection.min_inliers = 6;
-  }
-  o.use_vp_tracker = pnh_.param("vp_tracker", true);
-  o.track_lines = pnh_.param("track_lines", o.track_lines);
-  o.anchor_orientation = pnh_.param("anchor_orientation", o.anchor_orientation);
-  o.klt.min_corner_gradient = pnh_.param("klt_min_corner_gradient", o.klt.min_corner_gradient);
-  o.klt.predict_motion = pnh_.param("klt_predict_motion", true);
-  o.klt.window_px = pnh_.param("klt_window_px", o.klt.window_px);
-  if (o.klt.window_px < 5) {
-    ROS_WARN("hybrid_vo: klt_window_px must be >= 5, using %d", KltTrackerOptions().window_px);
-    o.klt.window_px = KltTrackerOptions().window_px;
-  }
-  o.concurrent = pnh_.param("concurrent_frontend", true);
+  XmlRpc::XmlRpcValue values;
+  pnh_.getParam(pnh_.getNamespace(), values);  // every private parameter, as a struct
+  std::vector<std::string> warnings;
+  params_ = read_node_parameters(values, &warnings);
+  for (const std::string& warning : warnings) ROS_WARN("hybrid_vo: %s", warning.c_str());
+  left_rectifier_ = right_rectifier_ = FisheyeRectifier(params_.rectified_fov_deg);
+  monitor_ = StreamMonitor(params_.stream);
 }
 
 void VoNode::run() {
@@ -267,7 +178,7 @@ bool VoNode::gray_of(const FrameImage& image, const CameraModel& camera, cv::Mat
 
 bool VoNode::rectify(const sensor_msgs::CameraInfo& info, FisheyeRectifier* rectifier,
                      CameraModel* camera, cv::Mat* image, std::string* reason) {
-  if (camera->model != LensModel::kEquidistant || !rectify_fisheye_) return true;
+  if (camera->model != LensModel::kEquidistant || !params_.rectify_fisheye) return true;
   Eigen::Matrix3d R;
   if (!rectification_from_info(info, &R)) {
     *reason = "R is not a rotation matrix";
@@ -293,7 +204,7 @@ bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
   const CameraModel lens = input->camera;
   if (!rectify(*frame.left_info, &left_rectifier_, &input->camera, &input->image, &reason))
     return reject("camera_info", reason, &invalid_camera_info_);
-  if (stereo_) {
+  if (params_.stereo) {
     CameraModel right;
     if (!camera_from_info(*frame.right_info, &right, &reason))
       return reject("right camera_info", reason, &invalid_camera_info_);
@@ -305,20 +216,20 @@ bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
       return reject("right camera_info", "P has no baseline term (P[3] = -fx * B)",
                     &invalid_camera_info_);
   }
-  if (use_feature_points_) {
-    const bool ok = vins_format_ ? points_from_vins(*frame.vins_points, input->camera.pinhole,
+  if (params_.feature_points) {
+    const bool ok = params_.vins_format ? points_from_vins(*frame.vins_points, input->camera.pinhole,
                                                     &input->external, &reason)
                                  : points_from_msg(*frame.points, &input->external, &reason);
     if (!ok) return reject("features/points", reason, &bad_features_);
   }
-  if (use_feature_lines_) {
-    const bool ok = vins_format_ ? lines_from_vins(*frame.vins_lines, input->camera.pinhole,
+  if (params_.feature_lines) {
+    const bool ok = params_.vins_format ? lines_from_vins(*frame.vins_lines, input->camera.pinhole,
                                                    &input->external, &reason)
                                  : lines_from_msg(*frame.lines, &input->external, &reason);
     if (!ok) return reject("features/lines", reason, &bad_features_);
   }
   std::lock_guard<std::mutex> lock(stats_mutex_);
-  if (compressed_) decode_ms_.add(decode_ms);
+  if (params_.compressed) decode_ms_.add(decode_ms);
   camera_model_ = describe_camera(*frame.left_info, lens, input->camera);
   return true;
 }

@@ -24,16 +24,16 @@ void VoNode::watchdog(const ros::TimerEvent&) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     images_flow =
-        !last_image_.isZero() && (now - last_image_).toSec() < camera_info_timeout_;
+        !last_image_.isZero() && (now - last_image_).toSec() < params_.camera_info_timeout;
     // A few images in a row, not one that is waiting for its camera_info after a pause.
     frames_flow = unsynced_images_ < 3 || (!last_synced_image_.isZero() &&
-                                           (now - last_synced_image_).toSec() < camera_info_timeout_);
+                                           (now - last_synced_image_).toSec() < params_.camera_info_timeout);
   }
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
     if (images_flow && !frames_flow) {
       last_problem_ = "images arrive without a matching camera_info" +
-                      std::string(stereo_ ? " (or without their stereo partner)" : "");
+                      std::string(params_.stereo ? " (or without their stereo partner)" : "");
       // One outage, however long; the frame after it restarts the chain (a time gap).
       if (!camera_info_outage_) ++camera_info_outages_;
       camera_info_outage_ = true;
@@ -76,9 +76,9 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
 
 void VoNode::add_input(diagnostic_updater::DiagnosticStatusWrapper& status) const {
   status.add("image topic", image_topic_);
-  status.add("image transport", compressed_ ? "compressed (decoded by the node)" : "raw");
+  status.add("image transport", params_.compressed ? "compressed (decoded by the node)" : "raw");
   status.add("camera model", camera_model_.empty() ? "no frame yet" : camera_model_);
-  if (compressed_) {
+  if (params_.compressed) {
     // Per frame (both images in stereo), from the last 200 frames.
     status.add("image decode p50 (ms)", decode_ms_.quantile(0.5));
     status.add("image decode p99 (ms)", decode_ms_.quantile(0.99));

@@ -7,43 +7,43 @@
 namespace hybrid_vo {
 
 void VoNode::subscribe() {
-  const std::string left = stereo_ ? "left/image" : "image";
-  const std::string left_info = stereo_ ? "left/camera_info" : "camera_info";
+  const std::string left = params_.stereo ? "left/image" : "image";
+  const std::string left_info = params_.stereo ? "left/camera_info" : "camera_info";
   // TCP_NODELAY: without it Nagle's algorithm holds a small camera_info (or the last segment of
   // an image) until the previous one is acknowledged, which adds up to 40 ms per frame.
   const ros::TransportHints no_delay = ros::TransportHints().tcpNoDelay();
   // The compressed topic is image_transport's: the resolved (remapped) image topic plus
   // "/compressed".
-  const std::string suffix = compressed_ ? "/compressed" : "";
+  const std::string suffix = params_.compressed ? "/compressed" : "";
   image_topic_ = nh_.resolveName(left) + suffix;
-  left_info_sub_.subscribe(nh_, left_info, queue_size_, no_delay);
-  if (stereo_) right_info_sub_.subscribe(nh_, "right/camera_info", queue_size_, no_delay);
-  if (compressed_) {
-    left_compressed_sub_.subscribe(nh_, image_topic_, queue_size_, no_delay);
-    if (stereo_)
-      right_compressed_sub_.subscribe(nh_, nh_.resolveName("right/image") + suffix, queue_size_,
+  left_info_sub_.subscribe(nh_, left_info, params_.queue_size, no_delay);
+  if (params_.stereo) right_info_sub_.subscribe(nh_, "right/camera_info", params_.queue_size, no_delay);
+  if (params_.compressed) {
+    left_compressed_sub_.subscribe(nh_, image_topic_, params_.queue_size, no_delay);
+    if (params_.stereo)
+      right_compressed_sub_.subscribe(nh_, nh_.resolveName("right/image") + suffix, params_.queue_size,
                                       no_delay);
     synchronise(&left_compressed_sub_, &right_compressed_sub_);
     arrival_sub_ = nh_.subscribe(image_topic_, 1,
                                  &VoNode::image_arrived<sensor_msgs::CompressedImage>, this,
                                  no_delay);
   } else {
-    left_sub_.subscribe(nh_, image_topic_, queue_size_, no_delay);
-    if (stereo_) right_sub_.subscribe(nh_, "right/image", queue_size_, no_delay);
+    left_sub_.subscribe(nh_, image_topic_, params_.queue_size, no_delay);
+    if (params_.stereo) right_sub_.subscribe(nh_, "right/image", params_.queue_size, no_delay);
     synchronise(&left_sub_, &right_sub_);
     arrival_sub_ =
         nh_.subscribe(image_topic_, 1, &VoNode::image_arrived<sensor_msgs::Image>, this, no_delay);
   }
-  if (use_feature_points_) {
-    points_sub_ = vins_format_ ? nh_.subscribe("features/points", queue_size_,
+  if (params_.feature_points) {
+    points_sub_ = params_.vins_format ? nh_.subscribe("features/points", params_.queue_size,
                                                &VoNode::vins_points_callback, this, no_delay)
-                               : nh_.subscribe("features/points", queue_size_,
+                               : nh_.subscribe("features/points", params_.queue_size,
                                                &VoNode::points_callback, this, no_delay);
   }
-  if (use_feature_lines_) {
-    lines_sub_ = vins_format_ ? nh_.subscribe("features/lines", queue_size_,
+  if (params_.feature_lines) {
+    lines_sub_ = params_.vins_format ? nh_.subscribe("features/lines", params_.queue_size,
                                               &VoNode::vins_lines_callback, this, no_delay)
-                              : nh_.subscribe("features/lines", queue_size_,
+                              : nh_.subscribe("features/lines", params_.queue_size,
                                               &VoNode::lines_callback, this, no_delay);
   }
 }
@@ -53,27 +53,27 @@ void VoNode::synchronise(message_filters::Subscriber<ImageMsg>* left,
                          message_filters::Subscriber<ImageMsg>* right) {
   namespace policies = message_filters::sync_policies;
   using Info = sensor_msgs::CameraInfo;
-  if (stereo_ && approximate_sync_) {
+  if (params_.stereo && params_.approximate_sync) {
     using Policy = policies::ApproximateTime<ImageMsg, Info, ImageMsg, Info>;
     auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(
-        Policy(queue_size_), *left, left_info_sub_, *right, right_info_sub_);
+        Policy(params_.queue_size), *left, left_info_sub_, *right, right_info_sub_);
     sync->registerCallback(&VoNode::stereo_callback<ImageMsg>, this);
     sync_ = sync;
-  } else if (stereo_) {
+  } else if (params_.stereo) {
     using Policy = policies::ExactTime<ImageMsg, Info, ImageMsg, Info>;
     auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(
-        Policy(queue_size_), *left, left_info_sub_, *right, right_info_sub_);
+        Policy(params_.queue_size), *left, left_info_sub_, *right, right_info_sub_);
     sync->registerCallback(&VoNode::stereo_callback<ImageMsg>, this);
     sync_ = sync;
-  } else if (approximate_sync_) {
+  } else if (params_.approximate_sync) {
     using Policy = policies::ApproximateTime<ImageMsg, Info>;
-    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(Policy(queue_size_),
+    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(Policy(params_.queue_size),
                                                                         *left, left_info_sub_);
     sync->registerCallback(&VoNode::mono_callback<ImageMsg>, this);
     sync_ = sync;
   } else {
     using Policy = policies::ExactTime<ImageMsg, Info>;
-    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(Policy(queue_size_),
+    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(Policy(params_.queue_size),
                                                                         *left, left_info_sub_);
     sync->registerCallback(&VoNode::mono_callback<ImageMsg>, this);
     sync_ = sync;
@@ -159,8 +159,8 @@ void VoNode::try_process(const ros::Time& stamp) {
   const auto it = pending_.find(stamp);
   if (it == pending_.end()) return;
   const Frame& f = it->second;
-  if (!f.have_images || (use_feature_points_ && !f.have_points) ||
-      (use_feature_lines_ && !f.have_lines))
+  if (!f.have_images || (params_.feature_points && !f.have_points) ||
+      (params_.feature_lines && !f.have_lines))
     return;
   Frame frame = f;
   frame.received = std::chrono::steady_clock::now();

@@ -78,9 +78,9 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
       result.status == VoStatus::kReset)
     publish_pose(frame.stamp, frame.frame_id, result, lost);
   publish_vanishing_points(frame.stamp, result);
-  if (publish_markers_ && markers_pub_.getNumSubscribers() > 0)
+  if (params_.publish_markers && markers_pub_.getNumSubscribers() > 0)
     publish_markers(frame.stamp, input, result);
-  if (publish_debug_image_ && debug_image_pub_.getNumSubscribers() > 0)
+  if (params_.publish_debug_image && debug_image_pub_.getNumSubscribers() > 0)
     publish_debug_image(frame, input, result);
 }
 
@@ -113,15 +113,15 @@ void VoNode::look_up_base_transform(const std::string& camera_frame) {
   looked_up_base_ = true;
   try {
     const geometry_msgs::TransformStamped bc =
-        tf_buffer_.lookupTransform(base_frame_, camera_frame, ros::Time(0), ros::Duration(0.5));
+        tf_buffer_.lookupTransform(params_.base_frame, camera_frame, ros::Time(0), ros::Duration(0.5));
     const Eigen::Isometry3d T = tf2::transformToEigen(bc);
     R_base_camera_ = T.rotation();
     t_base_camera_ = T.translation();
     have_base_transform_ = true;
   } catch (const tf2::TransformException& e) {
     have_base_transform_ = false;
-    ROS_INFO("hybrid_vo: no %s -> %s transform (%s); publishing %s -> %s", base_frame_.c_str(),
-             camera_frame.c_str(), e.what(), odom_frame_.c_str(), camera_frame.c_str());
+    ROS_INFO("hybrid_vo: no %s -> %s transform (%s); publishing %s -> %s", params_.base_frame.c_str(),
+             camera_frame.c_str(), e.what(), params_.odom_frame.c_str(), camera_frame.c_str());
   }
 }
 
@@ -138,14 +138,14 @@ void VoNode::publish_pose(const ros::Time& stamp, const std::string& camera_fram
     base_camera.linear() = R_base_camera_;
     base_camera.translation() = t_base_camera_;
     pose = base_camera * camera_in_world * base_camera.inverse();
-    child = base_frame_;
+    child = params_.base_frame;
   }
   geometry_msgs::TransformStamped tf;
   tf.header.stamp = stamp;
-  tf.header.frame_id = odom_frame_;
+  tf.header.frame_id = params_.odom_frame;
   tf.child_frame_id = child;
   tf.transform = to_transform(pose.rotation(), pose.translation());
-  if (publish_tf_) tf_broadcaster_.sendTransform(tf);
+  if (params_.publish_tf) tf_broadcaster_.sendTransform(tf);
   publish_odometry(tf, pose, lost);
 }
 
@@ -182,8 +182,8 @@ void VoNode::publish_odometry(const geometry_msgs::TransformStamped& tf,
   path_.poses.push_back(p);
   // A bounded window: the latched path is serialised on every frame, so an unbounded one would
   // cost more memory and time with every frame of a long run.
-  if (path_max_poses_ > 0 && path_.poses.size() > static_cast<size_t>(path_max_poses_))
-    path_.poses.erase(path_.poses.begin(), path_.poses.end() - path_max_poses_);
+  if (params_.path_max_poses > 0 && path_.poses.size() > static_cast<size_t>(params_.path_max_poses))
+    path_.poses.erase(path_.poses.begin(), path_.poses.end() - params_.path_max_poses);
   path_pub_.publish(path_);
 }
 
@@ -195,7 +195,7 @@ void VoNode::publish_vanishing_points(const ros::Time& stamp, const VisualOdomet
   // Tracked VPs, in the odometry frame (the first camera's frame turned into odom_frame).
   VanishingPoints vps;
   vps.header.stamp = stamp;
-  vps.header.frame_id = odom_frame_;
+  vps.header.frame_id = params_.odom_frame;
   for (const VpTrack& track : vo_->vp_tracker().tracks()) {
     VanishingPoint vp;
     vp.id = track.id;

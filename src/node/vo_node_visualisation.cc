@@ -43,7 +43,7 @@ void VoNode::publish_markers(const ros::Time& stamp, const VisualOdometryInput& 
                              const VisualOdometryResult& result) {
   std_msgs::Header header;
   header.stamp = stamp;
-  header.frame_id = odom_frame_;
+  header.frame_id = params_.odom_frame;
   visualization_msgs::MarkerArray markers;
   visualization_msgs::Marker clear;
   clear.action = visualization_msgs::Marker::DELETEALL;

@@ -52,22 +52,7 @@ class MatrixArgument {
   py::ssize_t rows_ = 0, cols_ = 0;
 };
 
-// Fixed-size inputs of the minimal solvers: N x 2 points, N x 4 segments (x1, y1, x2, y2), VPs
-// as 3-vectors (N x 3 for several), each VP non-zero.
-template <int N>
-std::array<Eigen::Vector2d, N> points_argument(py::handle value, const std::string& name) {
-  const MatrixArgument m(value, name, 2, N);
-  std::array<Eigen::Vector2d, N> out;
-  for (int i = 0; i < N; ++i) out[i] = m.point(i);
-  return out;
-}
-template <int N>
-std::array<LineSegment, N> segments_argument(py::handle value, const std::string& name) {
-  const MatrixArgument m(value, name, 4, N);
-  std::array<LineSegment, N> out;
-  for (int i = 0; i < N; ++i) out[i] = m.segment(i);
-  return out;
-}
+// N x 3 directions (a 3-vector for N = 1), none of them zero.
 std::vector<Eigen::Vector3d> directions_argument(py::handle value, const std::string& name,
                                                  py::ssize_t rows);
 

@@ -1,18 +1,12 @@
-// The minimal solvers (paper Fig. 2), one Python function per C++ function, plus the dispatcher
-// solve_minimal and the solver table.
+// The minimal solvers (paper Fig. 2): one Python function per C++ function, generated from the
+// solver table (its inputs give the arguments), the dispatcher solve_minimal, the table itself,
+// and pose errors.
+#include <map>
+
 #include "bindings.h"
 #include "hybrid_vo/geometry/epipolar_error.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
-#include "hybrid_vo/solvers/relpose_1vp_2line_1pt.h"
-#include "hybrid_vo/solvers/relpose_1vp_2pt_orth.h"
-#include "hybrid_vo/solvers/relpose_1vp_3line.h"
-#include "hybrid_vo/solvers/relpose_1vp_3pt.h"
-#include "hybrid_vo/solvers/relpose_1vp_orthline_2pt.h"
-#include "hybrid_vo/solvers/relpose_2pt_3line.h"
-#include "hybrid_vo/solvers/relpose_2vp_2pt.h"
-#include "hybrid_vo/solvers/relpose_5pt.h"
-#include "hybrid_vo/solvers/relpose_homography.h"
 
 namespace hybrid_vo {
 namespace python {
@@ -37,232 +31,154 @@ Eigen::Vector3d translation_argument(py::handle value, const char* name) {
   return MatrixArgument(value, name, 3, 1).vector3(0);
 }
 
-Eigen::Vector3d vp_argument(py::handle value, const std::string& name) {
-  return directions_argument(value, name, 1)[0];
+// The Python parameter names of a solver, in its C++ argument order: VPs, segments, points for
+// the VP solvers, points then segments for the others; and its sign keyword (or "").
+std::vector<std::string> solver_parameters(const SolverInfo& info, std::string* sign_keyword) {
+  std::vector<std::string> names;
+  auto add = [&](bool present, const char* a, const char* b) {
+    if (present) names.insert(names.end(), {a, b});
+  };
+  add(info.num_vps > 0, "v1", "v2");
+  add(info.num_vps == 0 && info.num_points > 0, "x1", "x2");
+  add(info.num_lines > 0, "s1", "s2");
+  add(info.num_vps > 0 && info.num_points > 0, "x1", "x2");
+  *sign_keyword = info.num_vps == 2 ? "vp_signs_known" : info.num_vps == 1 ? "vp_sign_known" : "";
+  return names;
 }
 
-std::array<Eigen::Vector3d, 2> two_vps_argument(py::handle value, const std::string& name) {
-  const std::vector<Eigen::Vector3d> d = directions_argument(value, name, 2);
-  return {d[0], d[1]};
+// The minimal sample of `info` from its arguments by name (x1, x2, s1, s2, v1, v2), as the C++
+// dispatcher takes it. For solve_minimal None means "not given"; a solver's own function reads
+// None as a bad array.
+MinimalSample read_sample(const SolverInfo& info, const std::map<std::string, py::handle>& given,
+                          bool none_is_absent) {
+  MinimalSample sample;
+  auto read = [&](const char* name, int count, auto&& fill) {
+    const auto it = given.find(name);
+    const bool none = it == given.end() || (none_is_absent && it->second.is_none());
+    if (count == 0) {
+      if (!none)
+        throw_value_error(name, std::string(info.function) + " takes no " +
+                                    (name[0] == 'x' ? "points" : name[0] == 's' ? "segments" : "VPs"));
+    } else if (none) {
+      throw_value_error(name, "required by " + std::string(info.function));
+    } else {
+      fill(it->second, name, count);
+    }
+  };
+  auto points = [](std::array<Eigen::Vector2d, 5>* out) {
+    return [out](py::handle v, const char* name, int n) {
+      const MatrixArgument a(v, name, 2, n);
+      for (int i = 0; i < n; ++i) (*out)[i] = a.point(i);
+    };
+  };
+  auto segments = [](std::array<LineSegment, 4>* out) {
+    return [out](py::handle v, const char* name, int n) {
+      const MatrixArgument a(v, name, 4, n);
+      for (int i = 0; i < n; ++i) (*out)[i] = a.segment(i);
+    };
+  };
+  auto vps = [](std::array<Eigen::Vector3d, 2>* out) {
+    return [out](py::handle v, const char* name, int n) {
+      const std::vector<Eigen::Vector3d> d = directions_argument(v, name, n);
+      for (int i = 0; i < n; ++i) (*out)[i] = d[i];
+    };
+  };
+  read("x1", info.num_points, points(&sample.x1));
+  read("x2", info.num_points, points(&sample.x2));
+  read("s1", info.num_lines, segments(&sample.s1));
+  read("s2", info.num_lines, segments(&sample.s2));
+  read("v1", info.num_vps, vps(&sample.v1));
+  read("v2", info.num_vps, vps(&sample.v2));
+  return sample;
 }
+
+// What each solver does beyond its inputs, for its docstring.
+const std::map<SolverId, const char*> kSolverDetails = {
+    {SolverId::k5pt, "Nister's five-point essential matrix, decomposed."},
+    {SolverId::kHomography4pt, "Homography by DLT from coplanar points, decomposed."},
+    {SolverId::kHomography3pt1l, "Points and segment on one plane; lines map as l1 ~ H^T l2."},
+    {SolverId::kHomography2pt2l,
+     "Degenerate for every input (a one-parameter family of homographies fits;\nREADME): it "
+     "always returns an empty list, and is listed for completeness."},
+    {SolverId::kHomography1pt3l, "Point and segments on one plane; homography by DLT."},
+    {SolverId::kHomography4l, "Four coplanar segments; homography by DLT."},
+    {SolverId::k2pt3line, "The three junctions of the coplanar segments complete five points."},
+    {SolverId::k1vp3pt, "Upright three-point after rotating the VP onto the y-axis."},
+    {SolverId::k1vp3line, "Coplanar segments, whose junctions are the points of 3-0-1."},
+    {SolverId::k2vp2pt, "Rotation from the two VPs (row k of v1 matches row k of v2)."},
+    {SolverId::k1vpOrthline2pt, "The segment's 3D line is orthogonal to the VP."},
+    {SolverId::k1vp2line1pt, "Intersecting segments, the first orthogonal to the VP."},
+    {SolverId::k1vp2ptOrth, "The points' 3D line is orthogonal to the VP."},
+};
 
 // The docstring of a solver: signature, configuration, inputs, and the shared conventions.
-std::string solver_doc(SolverId id, const std::string& signature, const std::string& details) {
-  const SolverInfo& info = solver_info(id);
-  return info.function + signature + "\n--\n\n" + info.code + ": " + info.inputs +
-         " (paper Fig. 2).\n\n" + details +
+std::string solver_doc(const SolverInfo& info, const std::vector<std::string>& names,
+                       const std::string& sign_keyword) {
+  std::string signature;
+  for (const std::string& name : names) signature += (signature.empty() ? "" : ", ") + name;
+  if (!sign_keyword.empty()) signature += ", " + sign_keyword + "=False";
+  return std::string(info.function) + "(" + signature + ")\n--\n\n" + info.code + ": " +
+         info.inputs + " (paper Fig. 2).\n\n" + kSolverDetails.at(info.id) +
+         (sign_keyword.empty() ? "" : "\nWith " + sign_keyword +
+                                          ", v2 = +R v1; otherwise the sign v2 = -R v1 is tried "
+                                          "too.") +
          "\nPoints are normalised image coordinates (K^-1 x) as N x 2 float64 arrays, segments "
          "their two\nendpoints as N x 4 (x1, y1, x2, y2), VPs directions (K^-1 v, any scale) as "
-         "3-vectors; index 1\nis the first image, 2 the second. Returns a list of (R, t) with X2 = "
-         "R X1 + t and unit t\n(t = 0 for a pure rotation), every real solution with all points "
-         "and segments in front of\nboth cameras; an empty list for degenerate input. Raises "
-         "ValueError for wrong shapes,\ndtypes, strides or non-finite values.";
+         "3-vectors (N x 3\nfor two); a single point or segment may be 1-D. Index 1 is the first "
+         "image, 2 the second.\nReturns a list of (R, t) with X2 = R X1 + t and unit t (t = 0 for "
+         "a pure rotation), every real\nsolution with all points and segments in front of both "
+         "cameras; an empty list for degenerate\ninput. Raises ValueError for wrong shapes, "
+         "dtypes, strides or non-finite values.";
 }
 
-const char* kVpSign =
-    "With vp_sign_known, v2 = +R v1; otherwise the sign v2 = -R v1 is tried too.\n";
-
-// Binds the solver `id` under its C++ name: `solve` reads the Python arguments (named by
-// `names`) and runs the C++ function; the docstring comes from solver_doc.
-template <typename... Handles, typename... Names>
-void def_solver(py::module_& m, SolverId id, const std::string& signature,
-                const std::string& details, void (*solve)(RelativePoses*, Handles...),
-                Names... names) {
+// Binds the solver under its C++ name and argument order; it runs through the dispatcher that
+// the hybrid RANSAC uses (solve_minimal), which calls the same function.
+void def_solver(py::module_& m, const SolverInfo& info) {
+  std::string sign_keyword;
+  const std::vector<std::string> names = solver_parameters(info, &sign_keyword);
   m.def(
-      solver_info(id).function,
-      [solve](Handles... arguments) {
+      info.function,
+      [&info, names, sign_keyword](const py::args& args, const py::kwargs& kwargs) {
+        const std::string function = info.function;
+        if (args.size() > names.size() + (sign_keyword.empty() ? 0 : 1))
+          throw py::type_error(function + "() takes " + std::to_string(names.size()) +
+                               " positional arguments");
+        std::map<std::string, py::handle> given;
+        for (size_t k = 0; k < args.size(); ++k)
+          given[k < names.size() ? names[k] : sign_keyword] = args[k];
+        for (const auto& item : kwargs) {
+          const std::string name = py::str(item.first);
+          if (std::find(names.begin(), names.end(), name) == names.end() && name != sign_keyword)
+            throw py::type_error(function + "() got an unexpected keyword argument '" + name + "'");
+          if (given.count(name)) throw py::type_error(function + "() got multiple values for '" + name + "'");
+          given[name] = item.second;
+        }
+        for (const std::string& name : names)
+          if (!given.count(name))
+            throw py::type_error(function + "() missing required argument '" + name + "'");
+        MinimalSample sample = read_sample(info, given, false);
+        const auto known = given.find(sign_keyword);
+        sample.vp_signs_known =
+            known != given.end() && bool_argument(known->second, sign_keyword);
         RelativePoses poses;
-        solve(&poses, arguments...);
+        solve_minimal(info.id, sample, &poses);
         return poses_to_list(poses);
       },
-      names..., solver_doc(id, signature, details).c_str());
+      solver_doc(info, names, sign_keyword).c_str());
 }
-
-using H = py::handle;
 
 }  // namespace
 
 void bind_solvers(py::module_& m) {
-  def_solver(
-      m, SolverId::k5pt, "(x1, x2)",
-      "x1, x2: 5 x 2 point matches. Nister's five-point essential matrix, decomposed.\n",
-      +[](RelativePoses* p, H x1, H x2) {
-        relpose_5pt(points_argument<5>(x1, "x1"), points_argument<5>(x2, "x2"), p);
-      },
-      "x1"_a, "x2"_a);
-
-  def_solver(
-      m, SolverId::kHomography4pt, "(x1, x2)",
-      "x1, x2: 4 x 2 matches of coplanar points. Homography by DLT, decomposed.\n",
-      +[](RelativePoses* p, H x1, H x2) {
-        relpose_homography_4pt(points_argument<4>(x1, "x1"), points_argument<4>(x2, "x2"), p);
-      },
-      "x1"_a, "x2"_a);
-
-  def_solver(
-      m, SolverId::kHomography3pt1l, "(x1, x2, s1, s2)",
-      "x1, x2: 3 x 2 point matches; s1, s2: one segment match (1 x 4 or 4,), all on one plane.\n"
-      "Lines map as l1 ~ H^T l2; the endpoints need not correspond.\n",
-      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
-        relpose_homography_3pt_1line(points_argument<3>(x1, "x1"), points_argument<3>(x2, "x2"),
-                                     segments_argument<1>(s1, "s1")[0],
-                                     segments_argument<1>(s2, "s2")[0], p);
-      },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
-
-  def_solver(
-      m, SolverId::kHomography2pt2l, "(x1, x2, s1, s2)",
-      "x1, x2: 2 x 2 point matches; s1, s2: 2 x 4 segment matches, coplanar.\n"
-      "Degenerate for every input (a one-parameter family of homographies fits; README): it "
-      "always\nreturns an empty list, and is listed for completeness.\n",
-      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
-        relpose_homography_2pt_2line(points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"),
-                                     segments_argument<2>(s1, "s1"), segments_argument<2>(s2, "s2"),
-                                     p);
-      },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
-
-  def_solver(
-      m, SolverId::kHomography1pt3l, "(x1, x2, s1, s2)",
-      "x1, x2: one point match (1 x 2 or 2,); s1, s2: 3 x 4 segment matches, all on one plane.\n",
-      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
-        relpose_homography_1pt_3line(
-            points_argument<1>(x1, "x1")[0], points_argument<1>(x2, "x2")[0],
-            segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), p);
-      },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
-
-  def_solver(
-      m, SolverId::kHomography4l, "(s1, s2)", "s1, s2: 4 x 4 matches of coplanar segments.\n",
-      +[](RelativePoses* p, H s1, H s2) {
-        relpose_homography_4line(segments_argument<4>(s1, "s1"), segments_argument<4>(s2, "s2"), p);
-      },
-      "s1"_a, "s2"_a);
-
-  def_solver(
-      m, SolverId::k2pt3line, "(x1, x2, s1, s2)",
-      "x1, x2: 2 x 2 point matches; s1, s2: 3 x 4 matches of coplanar segments, whose three\n"
-      "junctions complete five points for the five-point solver.\n",
-      +[](RelativePoses* p, H x1, H x2, H s1, H s2) {
-        relpose_2pt_3line(points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"),
-                          segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), p);
-      },
-      "x1"_a, "x2"_a, "s1"_a, "s2"_a);
-
-  def_solver(
-      m, SolverId::k1vp3pt, "(v1, v2, x1, x2, vp_sign_known=False)",
-      std::string("v1, v2: one VP match; x1, x2: 3 x 2 point matches. Upright three-point after "
-                  "rotating the VP\nonto the y-axis.\n") +
-          kVpSign,
-      +[](RelativePoses* p, H v1, H v2, H x1, H x2, H known) {
-        relpose_1vp_3pt(vp_argument(v1, "v1"), vp_argument(v2, "v2"), points_argument<3>(x1, "x1"),
-                        points_argument<3>(x2, "x2"), p, bool_argument(known, "vp_sign_known"));
-      },
-      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
-
-  def_solver(
-      m, SolverId::k1vp3line, "(v1, v2, s1, s2, vp_sign_known=False)",
-      std::string("v1, v2: one VP match; s1, s2: 3 x 4 matches of coplanar segments (their "
-                  "junctions are the\npoints of 3-0-1).\n") +
-          kVpSign,
-      +[](RelativePoses* p, H v1, H v2, H s1, H s2, H known) {
-        relpose_1vp_3line(vp_argument(v1, "v1"), vp_argument(v2, "v2"),
-                          segments_argument<3>(s1, "s1"), segments_argument<3>(s2, "s2"), p,
-                          bool_argument(known, "vp_sign_known"));
-      },
-      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "vp_sign_known"_a = false);
-
-  def_solver(
-      m, SolverId::k2vp2pt, "(v1, v2, x1, x2, vp_signs_known=False)",
-      "v1, v2: two VP matches (2 x 3, row k of v1 matches row k of v2); x1, x2: 2 x 2 point "
-      "matches.\nWith vp_signs_known, v2 = +R v1 for both; otherwise every sign is tried.\n",
-      +[](RelativePoses* p, H v1, H v2, H x1, H x2, H known) {
-        relpose_2vp_2pt(two_vps_argument(v1, "v1"), two_vps_argument(v2, "v2"),
-                        points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"), p,
-                        bool_argument(known, "vp_signs_known"));
-      },
-      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_signs_known"_a = false);
-
-  def_solver(
-      m, SolverId::k1vpOrthline2pt, "(v1, v2, s1, s2, x1, x2, vp_sign_known=False)",
-      std::string("v1, v2: one VP match; s1, s2: one segment match (1 x 4 or 4,) whose 3D line "
-                  "is orthogonal\nto the VP; x1, x2: 2 x 2 point matches.\n") +
-          kVpSign,
-      +[](RelativePoses* p, H v1, H v2, H s1, H s2, H x1, H x2, H known) {
-        relpose_1vp_orthline_2pt(
-            vp_argument(v1, "v1"), vp_argument(v2, "v2"), segments_argument<1>(s1, "s1")[0],
-            segments_argument<1>(s2, "s2")[0], points_argument<2>(x1, "x1"),
-            points_argument<2>(x2, "x2"), p, bool_argument(known, "vp_sign_known"));
-      },
-      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
-
-  def_solver(
-      m, SolverId::k1vp2line1pt, "(v1, v2, s1, s2, x1, x2, vp_sign_known=False)",
-      std::string("v1, v2: one VP match; s1, s2: 2 x 4 matches of intersecting segments, the "
-                  "first orthogonal\nto the VP; x1, x2: one point match (1 x 2 or 2,).\n") +
-          kVpSign,
-      +[](RelativePoses* p, H v1, H v2, H s1, H s2, H x1, H x2, H known) {
-        relpose_1vp_2line_1pt(vp_argument(v1, "v1"), vp_argument(v2, "v2"),
-                              segments_argument<2>(s1, "s1"), segments_argument<2>(s2, "s2"),
-                              points_argument<1>(x1, "x1")[0], points_argument<1>(x2, "x2")[0], p,
-                              bool_argument(known, "vp_sign_known"));
-      },
-      "v1"_a, "v2"_a, "s1"_a, "s2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
-
-  def_solver(
-      m, SolverId::k1vp2ptOrth, "(v1, v2, x1, x2, vp_sign_known=False)",
-      std::string("v1, v2: one VP match; x1, x2: 2 x 2 point matches whose 3D points span a line "
-                  "orthogonal\nto the VP.\n") +
-          kVpSign,
-      +[](RelativePoses* p, H v1, H v2, H x1, H x2, H known) {
-        relpose_1vp_2pt_orth(vp_argument(v1, "v1"), vp_argument(v2, "v2"),
-                             points_argument<2>(x1, "x1"), points_argument<2>(x2, "x2"), p,
-                             bool_argument(known, "vp_sign_known"));
-      },
-      "v1"_a, "v2"_a, "x1"_a, "x2"_a, "vp_sign_known"_a = false);
+  for (const SolverInfo& info : solver_table()) def_solver(m, info);
 
   m.def(
       "solve_minimal",
       [](py::handle solver, py::handle x1, py::handle x2, py::handle s1, py::handle s2,
          py::handle v1, py::handle v2, py::handle known) {
         const SolverInfo& info = solver_info(solver_argument(solver, "solver"));
-        MinimalSample sample;
-        auto read = [&](py::handle value, const char* name, int count, auto&& fill) {
-          if (count == 0) {
-            if (!value.is_none())
-              throw_value_error(name, std::string(info.function) + " takes no " +
-                                          (name[0] == 'x'   ? "points"
-                                           : name[0] == 's' ? "segments"
-                                                            : "VPs"));
-            return;
-          }
-          if (value.is_none()) throw_value_error(name, "required by " + std::string(info.function));
-          fill(value, count);
-        };
-        auto points = [&](py::handle value, const char* name, std::array<Eigen::Vector2d, 5>* out) {
-          read(value, name, info.num_points, [&](py::handle v, int n) {
-            const MatrixArgument a(v, name, 2, n);
-            for (int i = 0; i < n; ++i) (*out)[i] = a.point(i);
-          });
-        };
-        auto segments = [&](py::handle value, const char* name, std::array<LineSegment, 4>* out) {
-          read(value, name, info.num_lines, [&](py::handle v, int n) {
-            const MatrixArgument a(v, name, 4, n);
-            for (int i = 0; i < n; ++i) (*out)[i] = a.segment(i);
-          });
-        };
-        auto vps = [&](py::handle value, const char* name, std::array<Eigen::Vector3d, 2>* out) {
-          read(value, name, info.num_vps, [&](py::handle v, int n) {
-            const std::vector<Eigen::Vector3d> d = directions_argument(v, name, n);
-            for (int i = 0; i < n; ++i) (*out)[i] = d[i];
-          });
-        };
-        points(x1, "x1", &sample.x1);
-        points(x2, "x2", &sample.x2);
-        segments(s1, "s1", &sample.s1);
-        segments(s2, "s2", &sample.s2);
-        vps(v1, "v1", &sample.v1);
-        vps(v2, "v2", &sample.v2);
+        MinimalSample sample = read_sample(
+            info, {{"x1", x1}, {"x2", x2}, {"s1", s1}, {"s2", s2}, {"v1", v1}, {"v2", v2}}, true);
         sample.vp_signs_known = bool_argument(known, "vp_signs_known");
         RelativePoses poses;
         solve_minimal(info.id, sample, &poses);

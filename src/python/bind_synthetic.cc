@@ -3,6 +3,8 @@
 #include <random>
 
 #include "bindings.h"
+#include "hybrid_vo/synthetic/manhattan_scene.h"
+#include "hybrid_vo/synthetic/minimal_instances.h"
 #include "options.h"
 
 namespace hybrid_vo {
@@ -13,7 +15,7 @@ using namespace pybind11::literals;
 
 uint64_t seed_argument(py::handle value) {
   uint64_t seed = 0;
-  read_option(value, "seed", Range::kAny, &seed);
+  read_option(value, "seed", Bounds(), &seed);
   return seed;
 }
 
@@ -82,7 +84,7 @@ void bind_synthetic(py::module_& parent) {
       [](py::handle solver, py::handle seed, const py::kwargs& kwargs) {
         const SolverInfo& info = solver_info(solver_argument(solver, "solver"));
         MinimalInstanceOptions options;
-        minimal_instance_option_table().apply(kwargs, &options, "minimal_instance");
+        apply_options(kwargs, &options, "minimal_instance");
         std::mt19937_64 rng(seed_argument(seed));
         const MinimalInstance instance = generate_minimal_instance(info.id, rng, options);
         return py::dict("solver"_a = info.function,
@@ -105,9 +107,9 @@ void bind_synthetic(py::module_& parent) {
       "manhattan_scenes",
       [](py::handle count, py::handle seed, const py::kwargs& kwargs) {
         int n = 0;
-        read_option(count, "count", Range::kNonNegative, &n);
+        read_option(count, "count", non_negative(), &n);
         ManhattanSceneOptions options;
-        manhattan_scene_option_table().apply(kwargs, &options, "manhattan_scenes");
+        apply_options(kwargs, &options, "manhattan_scenes");
         std::mt19937_64 rng(seed_argument(seed));
         py::list out;
         for (int i = 0; i < n; ++i)
@@ -126,7 +128,7 @@ void bind_synthetic(py::module_& parent) {
       "(scene_options() lists them with their defaults).");
 
   m.def(
-      "scene_options", [] { return manhattan_scene_option_table().to_dict({}); },
+      "scene_options", [] { return options_dict(ManhattanSceneOptions()); },
       "scene_options()\n--\n\nThe options of manhattan_scenes with their defaults.");
 }
 

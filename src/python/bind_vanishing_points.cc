@@ -20,7 +20,7 @@ std::vector<LineSegment> read_segments(py::handle value, const std::string& name
 
 VpDetectionOptions read_options(const py::kwargs& options, const char* function) {
   VpDetectionOptions out;
-  vp_detection_option_table().apply(options, &out, function);
+  apply_options(options, &out, function);
   return out;
 }
 
@@ -102,7 +102,7 @@ void bind_vanishing_points(py::module_& m) {
       "**options)\n--\n\nTwo-view VP detection; see hybrid_vo.detect_vanishing_points.");
 
   m.def(
-      "vp_detection_options", [] { return vp_detection_option_table().to_dict({}); },
+      "vp_detection_options", [] { return options_dict(VpDetectionOptions()); },
       "vp_detection_options()\n--\n\n"
       "Every keyword option of detect_vanishing_points (VpDetectionOptions) with its default.");
 }

@@ -165,7 +165,7 @@ int run(int argc, char** argv) {
       }
     }
     else if (a == "--seed" && i + 1 < argc)
-      o.estimator.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
+      o.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
     else if (a == "--period-ms" && i + 1 < argc) period_ms = std::atof(argv[++i]);
     else if (a == "--stereo-window" && i + 1 < argc) o.stereo.window_px = std::atoi(argv[++i]);
@@ -179,12 +179,12 @@ int run(int argc, char** argv) {
       return 2;
     }
   }
-  if (!preset_options(preset, &o.estimator.estimator)) {
+  if (!preset_options(preset, &o.estimator)) {
     std::cerr << "unknown preset " << preset << "\n";
     return 2;
   }
   // As config/kitti.yaml sets the node.
-  o.klt.max_features = o.features.points.max_features = max_features;
+  o.features.points.max_features = max_features;
   o.estimator.vp_detection.min_inliers = vp_min_inliers;
 
   std::string error;
@@ -440,7 +440,7 @@ int run(int argc, char** argv) {
   }
   if (direct_gap > 0)
     print_direct_check(images, input.camera, odometry, truth, direct_gap,
-                       o.estimator.estimator.ransac.seed);
+                       o.estimator.ransac.seed);
   if (!trajectory_path.empty() &&
       !evaluation::write_tum_trajectory(trajectory_path, odometry, &error)) {
     std::cerr << error << "\n";

@@ -439,14 +439,14 @@ int main(int argc, char** argv) {
         };
         for (const std::string& preset : args.presets) {
           TwoViewOptions options;
-          preset_options(preset, &options.estimator);
-          if (args.min_iterations > 0) options.estimator.ransac.min_iterations = args.min_iterations;
+          preset_options(preset, &options);
+          if (args.min_iterations > 0) options.ransac.min_iterations = args.min_iterations;
           if (args.point_threshold > 0.0)
-            options.estimator.ransac.point_threshold_px = args.point_threshold;
+            options.ransac.point_threshold_px = args.point_threshold;
           if (args.vp_min_inliers > 0) options.vp_detection.min_inliers = args.vp_min_inliers;
           if (args.five_point_share >= 0.0)
-            options.estimator.ransac.five_point_share = args.five_point_share;
-          options.estimator.ransac.seed = seed;
+            options.ransac.five_point_share = args.five_point_share;
+          options.ransac.seed = seed;
           const auto start = std::chrono::steady_clock::now();
           const TwoViewEstimate result =
               estimate_two_view(c0.pinhole, c1.pinhole, matches, options);

@@ -299,14 +299,14 @@ int main(int argc, char** argv) {
   }
 
   hybrid_vo::VisualOdometryOptions options;
-  if (!hybrid_vo::preset_options(preset, &options.estimator.estimator)) {
+  if (!hybrid_vo::preset_options(preset, &options.estimator)) {
     std::cerr << "error: unknown preset '" << preset << "'\n";
     return 2;
   }
   options.klt = klt;
   options.stereo_refine_tracks = refine_tracks;
   options.stereo_track_refinement.window_px = refine_window;
-  options.klt.max_features = max_features;
+  options.features.points.max_features = max_features;
   options.estimator.vp_detection.min_inliers = 6;  // as the node
   hybrid_vo::VisualOdometry vo(options);
 

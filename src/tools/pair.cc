@@ -64,8 +64,8 @@ int main(int argc, char** argv) {
   if (!camera2_text.empty() && !evaluation::parse_camera(camera2_text, &camera2, &error))
     return fail(error, 2);
   TwoViewOptions options;
-  if (!preset_options(preset, &options.estimator)) return fail("unknown preset '" + preset + "'", 2);
-  options.estimator.ransac.seed = seed;
+  if (!preset_options(preset, &options)) return fail("unknown preset '" + preset + "'", 2);
+  options.ransac.seed = seed;
   FrontendOptions frontend;
   if (points == "orb") frontend.points.type = PointFeatureType::kOrb;
   else if (points != "sift") return fail("--points must be sift or orb", 2);

@@ -171,7 +171,7 @@ def test_presets_and_options():
         (dict(min_iterations=1.5), "min_iterations: expected an integer"),
         (dict(min_iterations=2**40), "min_iterations: integer out of range"),
         (dict(seed=-1), "seed: must be >= 0"),
-        (dict(final_refinement=1), "final_refinement: expected True or False"),
+        (dict(refinement_enabled=1), "refinement_enabled: expected True or False"),
         (dict(enabled={"relpose_6pt": True}), "enabled: unknown solver 'relpose_6pt'"),
         (dict(enabled={"5-0-0": 1}), "enabled\\['5-0-0'\\]: expected True or False"),
         (dict(enabled=[True] * 12), "enabled: 12 values, expected one per solver"),
@@ -184,7 +184,7 @@ def test_presets_and_options():
             estimate(**changes)
     # Numpy scalars are numbers, and per-solver lists work.
     assert estimate(point_threshold_px=np.float32(1.5), min_iterations=np.int64(160),
-                    enabled=[True] * 13, final_refinement=np.bool_(False)).ok
+                    enabled=[True] * 13, refinement_enabled=np.bool_(False)).ok
 
 
 def test_vanishing_point_and_synthetic_arguments():

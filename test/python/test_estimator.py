@@ -3,6 +3,8 @@ pose, the inlier masks against the scene's truth, the statistics, and that every
 the VP detection in front reach the C++ estimator."""
 import concurrent.futures
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -111,7 +113,7 @@ def test_options_reach_the_estimator():
     assert est.solver_statistics["relpose_5pt"]["sampled"] == 0
     assert est.solver_statistics["relpose_2vp_2pt"]["sampled"] == 0
     assert est.solver_statistics["relpose_1vp_3pt"]["sampled"] > 0
-    est = hybrid_vo.estimate_relative_pose(**inputs, min_iterations=400, final_refinement=False)
+    est = hybrid_vo.estimate_relative_pose(**inputs, min_iterations=400, refinement_enabled=False)
     assert est.iterations >= 400 and not est.refined and est.covariance is None
     loose = hybrid_vo.estimate_relative_pose(**inputs, point_threshold_px=5.0)
     tight = hybrid_vo.estimate_relative_pose(**inputs, point_threshold_px=0.3)
@@ -119,6 +121,23 @@ def test_options_reach_the_estimator():
     assert len(hybrid_vo.estimate_relative_pose(**inputs, use_junction_points=False,
                                                 junctions_min_angle_deg=80.0).junctions) < \
         len(hybrid_vo.estimate_relative_pose(**inputs).junctions)
+
+
+def test_a_renamed_option_still_works_with_a_deprecation_warning():
+    # final_refinement became refinement_enabled when the options were flattened (issue 33).
+    inputs = SCENES[0]["inputs"]
+    with pytest.warns(DeprecationWarning, match="'final_refinement' is deprecated, use "
+                                                "'refinement_enabled'"):
+        old = hybrid_vo.estimate_relative_pose(**inputs, seed=3, final_refinement=False)
+    new = hybrid_vo.estimate_relative_pose(**inputs, seed=3, refinement_enabled=False)
+    assert not old.refined and not new.refined
+    assert np.array_equal(old.R, new.R) and np.array_equal(old.t, new.t)
+    assert "final_refinement" not in hybrid_vo.estimator_options()
+    assert hybrid_vo.estimator_options()["refinement_enabled"] is True
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the warning is an error where the caller asks for it
+        with pytest.raises(DeprecationWarning):
+            hybrid_vo.estimate_relative_pose(**inputs, final_refinement=True)
 
 
 @pytest.mark.parametrize("preset", ["5pc", "hybrid+junc"])

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "hybrid_vo/geometry/option_fields.h"
 #include <vector>
 
 #include "hybrid_vo/estimation/matches.h"
@@ -32,6 +33,15 @@ struct JunctionOptions {
   // once (distinct_junctions).
   double duplicate_px = 2.0;
 };
+
+template <typename Visit>
+void visit_fields(JunctionOptions& o, Visit&& visit) {
+  visit("tolerance_px", o.tolerance_px, non_negative());
+  visit("length_fraction", o.length_fraction, non_negative());
+  visit("max_tolerance_px", o.max_tolerance_px, non_negative());
+  visit("min_angle_deg", o.min_angle_deg, non_negative());
+  visit("duplicate_px", o.duplicate_px, non_negative());
+}
 
 // Junctions of segment matches (paper supp. Sec. B): pairs whose intersection lies on both
 // segments, up to the tolerance (junction_tolerance_px), in both images. Invalid (zero-length, non-finite) segments never

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "hybrid_vo/geometry/option_fields.h"
 #include <vector>
 
 #include <Eigen/Core>
@@ -38,6 +39,7 @@ namespace hybrid_vo {
 // none: it passed its gate (the estimator's chi-square test) before it got here, and a robust
 // loss would switch it off exactly when the drift it exists to correct has grown.
 struct FinalRefinementOptions {
+  bool enabled = true;  // false: the RANSAC's (locally optimised) model is the estimate
   // Standard deviations of the modalities. A sigma that is not finite and positive leaves its
   // modality out.
   double point_sigma_px = 1.0 / 3.0;
@@ -59,6 +61,22 @@ struct FinalRefinementOptions {
   double function_tolerance = 1e-6;
   double parameter_tolerance = 1e-8;
 };
+
+template <typename Visit>
+void visit_fields(FinalRefinementOptions& o, Visit&& visit) {
+  visit("enabled", o.enabled);
+  visit("point_sigma_px", o.point_sigma_px);
+  visit("line_vp_sigma_px", o.line_vp_sigma_px);
+  visit("vp_sigma_deg", o.vp_sigma_deg);
+  visit("point_loss_px", o.point_loss_px);
+  visit("line_vp_loss_px", o.line_vp_loss_px);
+  visit("vp_loss_deg", o.vp_loss_deg);
+  visit("refine_vp_directions", o.refine_vp_directions);
+  visit("max_iterations", o.max_iterations, non_negative());
+  visit("compute_covariance", o.compute_covariance);
+  visit("function_tolerance", o.function_tolerance, positive());
+  visit("parameter_tolerance", o.parameter_tolerance, positive());
+}
 
 // The refinement's data: inliers of the estimate.
 struct RefinementData {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include "hybrid_vo/geometry/option_fields.h"
 #include <vector>
 
 namespace hybrid_vo {
@@ -47,6 +48,22 @@ struct ModalityScaleOptions {
   // lost 0.1-0.3 AUC@10 to 5pc.
   double max_independent_points = 16.0;
 };
+
+template <typename Visit>
+void visit_fields(ModalityScaleOptions& o, Visit&& visit) {
+  visit("enabled", o.enabled);
+  visit("min_points", o.min_points, non_negative());
+  visit("min_junctions", o.min_junctions, non_negative());
+  visit("min_lines", o.min_lines, non_negative());
+  visit("min_vps", o.min_vps, non_negative());
+  visit("inlier_multiple", o.inlier_multiple, positive());
+  visit("line_threshold_px", o.line_threshold_px, positive());
+  visit("default_fraction", o.default_fraction, positive());
+  visit("min_point_px", o.min_point_px, non_negative());
+  visit("min_line_px", o.min_line_px, non_negative());
+  visit("min_vp_deg", o.min_vp_deg, non_negative());
+  visit("max_independent_points", o.max_independent_points, positive());
+}
 
 // Robust standard deviation per axis of zero-mean Gaussian residuals from their magnitudes: the
 // median magnitude over the median of |N(0,1)| (0.6745) for one axis, or over that of a Rayleigh

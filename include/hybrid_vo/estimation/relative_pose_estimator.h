@@ -12,6 +12,7 @@
 #include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/estimation/modality_scales.h"
 #include "hybrid_vo/geometry/camera.h"
+#include "hybrid_vo/geometry/option_fields.h"
 #include "hybrid_vo/geometry/pose.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
 
@@ -61,15 +62,36 @@ struct HybridRansacOptions {
   HybridRansacOptions();
 };
 
+template <typename Visit>
+void visit_fields(HybridRansacOptions& o, Visit&& visit) {
+  visit("enabled", o.enabled);
+  visit("prior", o.prior, non_negative());
+  visit("point_threshold_px", o.point_threshold_px, positive());
+  visit("vp_threshold_deg", o.vp_threshold_deg, positive());
+  visit("line_inlier_ratio", o.line_inlier_ratio, fraction());
+  visit("initial_point_inlier_ratio", o.initial_point_inlier_ratio, fraction());
+  visit("initial_vp_inlier_ratio", o.initial_vp_inlier_ratio, fraction());
+  visit("exploration", o.exploration, fraction());
+  visit("five_point_share", o.five_point_share, fraction());
+  visit("confidence", o.confidence, open_fraction());
+  visit("min_iterations", o.min_iterations, non_negative());
+  visit("max_iterations", o.max_iterations, positive());
+  visit("local_optimization", o.local_optimization);
+  visit("lo_max_points", o.lo_max_points, positive());
+  visit("lo_rounds", o.lo_rounds, non_negative());
+  visit("orthogonal_tolerance_deg", o.orthogonal_tolerance_deg, non_negative());
+  visit("seed", o.seed);
+}
+
 struct RelativePoseEstimatorOptions {
   HybridRansacOptions ransac;
   // Point-like data besides the point matches; line solvers use junctions either way.
   bool use_junction_points = false;
   bool use_endpoint_points = false;
   JunctionOptions junctions;
-  bool final_refinement = true;
-  // The refinement's sigmas come from the pair's own inliers (ModalityScales) unless disabled;
-  // its other settings from `refinement`.
+  // The refinement's sigmas come from the pair's own inliers (ModalityScales) unless disabled,
+  // its Cauchy scales from the inlier thresholds; its other settings (and whether it runs at
+  // all) from `refinement`.
   ModalityScaleOptions scales;
   FinalRefinementOptions refinement;
   // A VP prior (TwoViewMatches::vp_priors) is used only when its direction, carried by the best
@@ -80,6 +102,23 @@ struct RelativePoseEstimatorOptions {
   // is not trusted and the status is kNoModel.
   int min_point_inliers = 5;
 };
+
+// The ransac fields without a prefix (the estimator's main knobs), each other component under its
+// member's name.
+template <typename Visit>
+void visit_fields(RelativePoseEstimatorOptions& o, Visit&& visit) {
+  visit_fields(o.ransac, visit);
+  visit("use_junction_points", o.use_junction_points);
+  visit("use_endpoint_points", o.use_endpoint_points);
+  visit_fields(o.junctions, prefixed("junctions_", visit));
+  // The sigmas and losses are set from the scales and thresholds above.
+  visit_fields(o.refinement, prefixed("refinement_", visit,
+                                      {"point_sigma_px", "line_vp_sigma_px", "vp_sigma_deg",
+                                       "point_loss_px", "line_vp_loss_px", "vp_loss_deg"}));
+  visit_fields(o.scales, prefixed("scales_", visit));
+  visit("vp_prior_gate_chi2", o.vp_prior_gate_chi2, non_negative());
+  visit("min_point_inliers", o.min_point_inliers, non_negative());
+}
 
 // The paper's table rows: "5pc", "5pc+junc", "5pc+4pc", "5pc+4pc+junc", "hybrid", "hybrid+junc".
 bool preset_options(const std::string& preset, RelativePoseEstimatorOptions* options);

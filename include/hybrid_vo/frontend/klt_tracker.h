@@ -7,11 +7,11 @@
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/geometry/option_fields.h"
 
 namespace hybrid_vo {
 
 struct KltTrackerOptions {
-  int max_features = 1000;  // a cap on the features tracked (and so on the matches per pair)
   int grid_cols = 8, grid_rows = 6;  // bucketing: re-detection fills empty cells first
   double min_distance_px = 10.0;     // between tracked features
   double quality_level = 0.01;       // of cv::goodFeaturesToTrack
@@ -44,6 +44,21 @@ struct KltTrackerOptions {
   int predicted_pyramid_levels = 1;
 };
 
+template <typename Visit>
+void visit_fields(KltTrackerOptions& o, Visit&& visit) {
+  visit("grid_cols", o.grid_cols, positive());
+  visit("grid_rows", o.grid_rows, positive());
+  visit("min_distance_px", o.min_distance_px, non_negative());
+  visit("quality_level", o.quality_level, Bounds{0.0, 1.0, true, false});
+  visit("min_corner_gradient", o.min_corner_gradient, non_negative());
+  visit("window_px", o.window_px, at_least(5));  // smaller windows lose the texture
+  visit("pyramid_levels", o.pyramid_levels, non_negative());
+  visit("max_forward_backward_px", o.max_forward_backward_px, positive());
+  visit("max_iterations", o.max_iterations, positive());
+  visit("predict_motion", o.predict_motion);
+  visit("predicted_pyramid_levels", o.predicted_pyramid_levels, non_negative());
+}
+
 // Sparse optical-flow tracking of corners between consecutive video frames, with re-detection in
 // empty buckets; each feature keeps a stable id across frames.
 class KltTracker {
@@ -52,7 +67,9 @@ class KltTracker {
   // A longer gap than this many of the last time steps is predicted as this many: beyond it the
   // constant-velocity guess is worth less than the long search it would replace.
   static constexpr double kMaxMotionScale = 4.0;
-  explicit KltTracker(const KltTrackerOptions& options = {});
+  // `max_features` caps the features tracked (and so the matches per pair); VisualOdometry passes
+  // its point features' cap, so that one number bounds the points whatever their source.
+  explicit KltTracker(const KltTrackerOptions& options = {}, int max_features = 1000);
   // Tracks the current features into `image` (grayscale) and re-detects: track_existing, then
   // detect_new. Returns the matches between the previous frame and this one (pixels) and their
   // track ids. The first call (or the first after reset) returns no matches. `stamp` (seconds,
@@ -83,6 +100,7 @@ class KltTracker {
   double motion_scale(double stamp) const;
 
   KltTrackerOptions options_;
+  int max_features_;
   cv::Size size_;
   std::vector<cv::Mat> previous_;  // image pyramid with derivatives, built once per frame
   std::vector<cv::Point2f> points_;

@@ -18,7 +18,7 @@ enum class PointFeatureType {
 // `video_point_matching_options()` (ORB), which keeps a KITTI pair near the 30 ms budget.
 struct PointMatchingOptions {
   PointFeatureType type = PointFeatureType::kSift;
-  int max_features = 4000;
+  int max_features = 4000;  // per image; VisualOdometry caps its KLT tracks by it too
   double ratio = 0.8;  // Lowe's ratio test on the two nearest neighbours
   bool mutual = true;  // keep a match only when it is the best in both directions
   // SIFT: layers per octave and contrast threshold (OpenCV's defaults, Lowe's values).

@@ -32,7 +32,9 @@ struct VisualOdometryOptions {
 
   PointFeatureSource point_source = PointFeatureSource::kTracking;
   bool use_lines = true;
-  FrontendOptions features;   // descriptors for points (kDescriptors) and segments
+  // Descriptors for points (kDescriptors) and segments. features.points.max_features is the one
+  // cap on the points per frame, whatever their source (the KLT tracker takes it too).
+  FrontendOptions features;
   KltTrackerOptions klt;
   // Segments tracked frame to frame by their own geometry (LineTracker) and paired with the
   // keyframe's by track id; false: the keyframe's segments matched by LBD in every frame.
@@ -68,6 +70,30 @@ struct VisualOdometryOptions {
   bool anchor_orientation = true;
   double rotation_drift_floor_deg = 0.005;
 };
+
+// Its own fields, the KLT tracker's under klt_, the estimator's (with the VP detection in front)
+// under estimator_, and of the components without a declaration of their own the fields that
+// the node sets.
+template <typename Visit>
+void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
+  visit("use_lines", o.use_lines);
+  visit("max_features", o.features.points.max_features, positive());
+  visit_fields(o.klt, prefixed("klt_", visit));
+  visit("track_lines", o.track_lines);
+  visit("concurrent", o.concurrent);
+  visit_fields(o.estimator, prefixed("estimator_", visit));
+  visit("min_parallax_px", o.min_parallax_px, non_negative());
+  visit("min_point_matches", o.min_point_matches, non_negative());
+  visit("min_line_matches", o.min_line_matches, non_negative());
+  visit("mono_scale", o.mono_scale, positive());
+  visit("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines, non_negative());
+  visit("stereo_offset_calibration", o.stereo_offset.enabled);
+  visit("stereo_current_disparity", o.stereo_current_disparity);
+  visit("stereo_refine_tracks", o.stereo_refine_tracks);
+  visit("use_vp_tracker", o.use_vp_tracker);
+  visit("anchor_orientation", o.anchor_orientation);
+  visit("rotation_drift_floor_deg", o.rotation_drift_floor_deg, non_negative());
+}
 
 // Externally detected features of a frame (e.g. from a learned front end); ids link them across
 // frames. Each modality present replaces the built-in one.

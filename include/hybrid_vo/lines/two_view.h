@@ -5,8 +5,9 @@
 
 namespace hybrid_vo {
 
-struct TwoViewOptions {
-  RelativePoseEstimatorOptions estimator;
+// The estimator's options with the VP detection in front of it, on one level: the estimator's
+// fields (ransac, junctions, ...) are TwoViewOptions' own.
+struct TwoViewOptions : RelativePoseEstimatorOptions {
   // When the matches carry no VPs and a VP solver is enabled, detect them from the line matches.
   bool detect_vps = true;
   bool joint_vp_detection = true;  // false: the per-image "standard" baseline
@@ -18,6 +19,15 @@ struct TwoViewOptions {
   // evaluation). The VO node sets its own (vp_min_inliers).
   TwoViewOptions() { vp_detection.min_inliers = 15; }
 };
+
+// The estimator's fields, then the detection's under vp_detection_ (its seed is the RANSAC's).
+template <typename Visit>
+void visit_fields(TwoViewOptions& o, Visit&& visit) {
+  visit_fields(static_cast<RelativePoseEstimatorOptions&>(o), visit);
+  visit("detect_vps", o.detect_vps);
+  visit("joint_vp_detection", o.joint_vp_detection);
+  visit_fields(o.vp_detection, prefixed("vp_detection_", visit, {"seed"}));
+}
 
 struct TwoViewEstimate {
   RelativePoseEstimate estimate;

@@ -8,6 +8,7 @@
 #include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/geometry/option_fields.h"
 
 namespace hybrid_vo {
 
@@ -35,6 +36,24 @@ struct VpDetectionOptions {
   double sign_agreement = 0.9;
   uint64_t seed = 0;
 };
+
+template <typename Visit>
+void visit_fields(VpDetectionOptions& o, Visit&& visit) {
+  visit("inlier_threshold_px", o.inlier_threshold_px, positive());
+  visit("min_segment_length_px", o.min_segment_length_px, non_negative());
+  visit("max_vps", o.max_vps, non_negative());
+  visit("min_inliers", o.min_inliers, at_least(2));  // two segments make a VP
+  visit("min_long_inliers", o.min_long_inliers, non_negative());
+  visit("min_support_px", o.min_support_px, non_negative());
+  visit("max_iterations", o.max_iterations, non_negative());
+  visit("confidence", o.confidence, open_fraction());
+  visit("merge_angle_deg", o.merge_angle_deg, non_negative());
+  visit("refine", o.refine);
+  visit("manhattan", o.manhattan);
+  visit("manhattan_tolerance_deg", o.manhattan_tolerance_deg, non_negative());
+  visit("sign_agreement", o.sign_agreement, fraction());
+  visit("seed", o.seed);
+}
 
 // A VP in one image: a unit direction in the camera frame (K^-1 v), its supporting segments, and
 // its score (the summed length of the supporting segments in pixels).

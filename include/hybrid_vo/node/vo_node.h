@@ -35,6 +35,7 @@
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/node/frame_queue.h"
 #include "hybrid_vo/node/latency_window.h"
+#include "hybrid_vo/node/node_parameters.h"
 #include "hybrid_vo/node/stream_monitor.h"
 
 namespace hybrid_vo {
@@ -73,7 +74,6 @@ class VoNode {
 
   // Parameters and processing (vo_node.cc).
   void load_parameters();
-  void load_odometry_options();
   // The processing thread: frames from the queue, one at a time, in arrival order.
   void run();
   void process(const Frame& frame);
@@ -164,18 +164,7 @@ class VoNode {
 
   ros::NodeHandle nh_, pnh_;
 
-  // Parameters.
-  std::string odom_frame_, base_frame_;
-  bool stereo_ = false, approximate_sync_ = false, publish_tf_ = true;
-  bool compressed_ = false;  // image_transport: compressed
-  bool rectify_fisheye_ = true;
-  bool use_feature_points_ = false, use_feature_lines_ = false, vins_format_ = false;
-  bool publish_debug_image_ = true, publish_markers_ = true;
-  int queue_size_ = 10;
-  int frame_queue_size_ = 1;
-  int path_max_poses_ = 5000;
-  double camera_info_timeout_ = 2.0;
-  VisualOdometryOptions vo_options_;
+  NodeParameters params_;
 
   // Input: one pair of image subscribers is in use (raw or compressed), and one synchroniser
   // (mono or stereo, exact or approximate time, of those images), held type-erased.
@@ -220,7 +209,6 @@ class VoNode {
   // Diagnostics: written by both sides and read by diagnose(), under stats_mutex_.
   std::mutex stats_mutex_;
   diagnostic_updater::Updater updater_;
-  double min_frequency_ = 1.0, max_frequency_ = 100.0;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
   ros::Time last_image_, last_synced_image_;
   int unsynced_images_ = 0;  // images since the last synchronised frame

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "hybrid_vo/geometry/option_fields.h"
 #include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/geometry/pose.h"
@@ -35,6 +36,28 @@ struct ManhattanSceneOptions {
   double min_segment_px = 40.0;    // segment length in image 1
   double max_segment_px = 300.0;
 };
+
+template <typename Visit>
+void visit_fields(ManhattanSceneOptions& o, Visit&& visit) {
+  visit("num_points", o.num_points, non_negative());
+  visit("planar_point_fraction", o.planar_point_fraction, fraction());
+  visit("num_segments", o.num_segments, non_negative());
+  visit("noise_px", o.noise_px, non_negative());
+  visit("point_outlier_ratio", o.point_outlier_ratio, fraction());
+  visit("line_outlier_ratio", o.line_outlier_ratio, fraction());
+  visit("num_vps", o.num_vps, non_negative());
+  visit("lines_per_vp_fit", o.lines_per_vp_fit, non_negative());
+  visit("vp_noise_deg", o.vp_noise_deg, non_negative());
+  visit("orient_vps", o.orient_vps);
+  visit("focal_px", o.focal_px, positive());
+  visit("width", o.width, positive());
+  visit("height", o.height, positive());
+  visit("baseline", o.baseline, non_negative());
+  visit("max_rotation_deg", o.max_rotation_deg, non_negative());
+  visit("junction_fraction", o.junction_fraction, fraction());
+  visit("min_segment_px", o.min_segment_px, positive());
+  visit("max_segment_px", o.max_segment_px, positive());
+}
 
 // An axis-aligned plane of the scene: normal . X = offset in camera-1 coordinates, with
 // normal = directions.col(direction). The box faces are finite; only this equation is exposed.

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "hybrid_vo/geometry/option_fields.h"
 #include "hybrid_vo/geometry/pose.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
 
@@ -26,6 +27,15 @@ struct MinimalInstanceOptions {
   // solver (the paper's supp. Fig. 5 protocol).
   int extra_points = 0;
 };
+
+template <typename Visit>
+void visit_fields(MinimalInstanceOptions& o, Visit&& visit) {
+  visit("noise", o.noise, non_negative());
+  visit("lines_per_vp", o.lines_per_vp, positive());
+  visit("orient_vps", o.orient_vps);
+  visit("scene_spread", o.scene_spread, positive());
+  visit("extra_points", o.extra_points, non_negative());
+}
 
 struct MinimalInstance {
   MinimalSample sample;

@@ -1,0 +1,215 @@
+// The node's ROS parameters: every one that config/default.yaml lists is read, each set to a value
+// other than its default changes what the node runs with, bad values and misspelt names are
+// reported and leave the default, and the options validate themselves (validate()).
+#include <fstream>
+#include <functional>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "hybrid_vo/node/node_parameters.h"
+
+namespace hybrid_vo {
+namespace {
+
+using XmlRpc::XmlRpcValue;
+
+std::string read_text(const std::string& relative) {
+  std::ifstream in(std::string(HYBRID_VO_SOURCE_DIR) + "/" + relative);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The top-level keys of a YAML file of parameters (`name: value` at the start of a line).
+std::set<std::string> yaml_keys(const std::string& relative) {
+  std::set<std::string> keys;
+  std::istringstream lines(read_text(relative));
+  const std::regex key(R"(^([a-z_0-9]+):)");
+  std::smatch m;
+  for (std::string line; std::getline(lines, line);)
+    if (std::regex_search(line, m, key)) keys.insert(m[1]);
+  return keys;
+}
+
+NodeParameters read_one(const std::string& name, const XmlRpcValue& value,
+                        std::vector<std::string>* warnings) {
+  XmlRpcValue params;
+  params[name] = value;
+  return read_node_parameters(params, warnings);
+}
+
+// One parameter set to a value other than its default, and what must then differ.
+struct Case {
+  std::string name;
+  XmlRpcValue value;
+  std::function<bool(const NodeParameters&)> took_effect;
+};
+
+std::vector<Case> every_parameter() {
+  using P = const NodeParameters&;
+  return {
+      {"preset", "5pc", [](P p) { return !p.odometry.estimator.ransac.enabled[7] && p.preset == "5pc"; }},
+      {"odom_frame", "world", [](P p) { return p.odom_frame == "world"; }},
+      {"base_frame", "robot", [](P p) { return p.base_frame == "robot"; }},
+      {"publish_tf", false, [](P p) { return !p.publish_tf; }},
+      {"stereo", true, [](P p) { return p.stereo; }},
+      {"approximate_sync", true, [](P p) { return p.approximate_sync; }},
+      {"image_transport", "compressed", [](P p) { return p.compressed; }},
+      {"rectify_fisheye", false, [](P p) { return !p.rectify_fisheye; }},
+      {"rectified_fov_deg", 120.0, [](P p) { return p.rectified_fov_deg == 120.0; }},
+      {"queue_size", 3, [](P p) { return p.queue_size == 3; }},
+      {"camera_info_timeout", 5.0, [](P p) { return p.camera_info_timeout == 5.0; }},
+      {"frame_queue_size", 4, [](P p) { return p.frame_queue_size == 4; }},
+      {"max_frame_gap", 2.5, [](P p) { return p.stream.max_gap_s == 2.5; }},
+      {"feature_points", true, [](P p) { return p.feature_points; }},
+      {"feature_lines", true, [](P p) { return p.feature_lines; }},
+      {"feature_format", "vins", [](P p) { return p.vins_format; }},
+      {"points", "orb",
+       [](P p) {
+         return p.odometry.point_source == PointFeatureSource::kDescriptors &&
+                p.odometry.features.points.type == PointFeatureType::kOrb;
+       }},
+      {"lines", "lsd",
+       [](P p) { return p.odometry.features.lines.detection.detector == LineDetector::kLsd; }},
+      {"max_features", 321, [](P p) { return p.odometry.features.points.max_features == 321; }},
+      {"min_parallax_px", 3.5, [](P p) { return p.odometry.min_parallax_px == 3.5; }},
+      {"track_lines", false, [](P p) { return !p.odometry.track_lines; }},
+      {"concurrent_frontend", false, [](P p) { return !p.odometry.concurrent; }},
+      {"klt_predict_motion", false, [](P p) { return !p.odometry.klt.predict_motion; }},
+      {"klt_window_px", 21, [](P p) { return p.odometry.klt.window_px == 21; }},
+      {"klt_min_corner_gradient", 1.5,
+       [](P p) { return p.odometry.klt.min_corner_gradient == 1.5; }},
+      {"point_threshold_px", 2.0,
+       [](P p) { return p.odometry.estimator.ransac.point_threshold_px == 2.0; }},
+      {"vp_threshold_deg", 3.0,
+       [](P p) { return p.odometry.estimator.ransac.vp_threshold_deg == 3.0; }},
+      {"vp_inlier_threshold_px", 1.0,
+       [](P p) { return p.odometry.estimator.vp_detection.inlier_threshold_px == 1.0; }},
+      {"vp_min_inliers", 15,
+       [](P p) { return p.odometry.estimator.vp_detection.min_inliers == 15; }},
+      {"vp_tracker", false, [](P p) { return !p.odometry.use_vp_tracker; }},
+      {"anchor_orientation", false, [](P p) { return !p.odometry.anchor_orientation; }},
+      {"mono_scale", 0.5, [](P p) { return p.odometry.mono_scale == 0.5; }},
+      {"stereo_max_depth_baselines", 60.0,
+       [](P p) { return p.odometry.stereo_scale.max_depth_baselines == 60.0; }},
+      {"stereo_offset_calibration", false, [](P p) { return !p.odometry.stereo_offset.enabled; }},
+      {"stereo_refine_tracks", false, [](P p) { return !p.odometry.stereo_refine_tracks; }},
+      {"publish_debug_image", false, [](P p) { return !p.publish_debug_image; }},
+      {"publish_markers", false, [](P p) { return !p.publish_markers; }},
+      {"path_max_poses", 10, [](P p) { return p.path_max_poses == 10; }},
+      {"min_frequency", 5.0, [](P p) { return p.min_frequency == 5.0; }},
+      {"max_frequency", 15.0, [](P p) { return p.max_frequency == 15.0; }},
+  };
+}
+
+TEST(NodeParameters, EveryParameterOfTheConfigIsReadAndNoOther) {
+  const std::vector<std::string> names = node_parameter_names();
+  const std::set<std::string> read(names.begin(), names.end());
+  EXPECT_EQ(read.size(), names.size()) << "a parameter is read twice";
+  EXPECT_EQ(yaml_keys("config/default.yaml"), read);
+  std::set<std::string> tested;
+  for (const Case& c : every_parameter()) tested.insert(c.name);
+  EXPECT_EQ(tested, read) << "every parameter needs a case below";
+  // The documentation's parameter table names each one.
+  const std::string doc = read_text("doc/node.md");
+  for (const std::string& name : names)
+    EXPECT_NE(doc.find("`" + name + "`"), std::string::npos) << name << " is not in doc/node.md";
+}
+
+TEST(NodeParameters, EachParameterChangesWhatTheNodeRunsWith) {
+  std::vector<std::string> warnings;
+  const NodeParameters defaults = read_node_parameters(XmlRpcValue(), &warnings);
+  EXPECT_TRUE(warnings.empty());
+  for (const Case& c : every_parameter()) {
+    EXPECT_FALSE(c.took_effect(defaults)) << c.name << ": the default already passes the check";
+    const NodeParameters p = read_one(c.name, c.value, &warnings);
+    EXPECT_TRUE(c.took_effect(p)) << c.name;
+    EXPECT_TRUE(warnings.empty()) << c.name << ": " << (warnings.empty() ? "" : warnings[0]);
+    EXPECT_EQ(validate(p), "") << c.name;
+  }
+}
+
+TEST(NodeParameters, TheDefaultsAreTheNodesOwn) {
+  std::vector<std::string> warnings;
+  const NodeParameters p = read_node_parameters(XmlRpcValue(), &warnings);
+  EXPECT_EQ(p.odometry.estimator.vp_detection.min_inliers, 6);  // not the pair tools' 15
+  EXPECT_EQ(p.odometry.features.points.max_features, 1000);
+  RelativePoseEstimatorOptions hybrid;
+  preset_options("hybrid", &hybrid);
+  EXPECT_EQ(p.odometry.estimator.ransac.enabled, hybrid.ransac.enabled);
+  EXPECT_EQ(p.preset, "hybrid");
+  // A threshold set beside a preset overrides it, in whichever order the server lists them.
+  XmlRpcValue params;
+  params["point_threshold_px"] = 2.0;
+  params["preset"] = "hybrid+junc";
+  const NodeParameters both = read_node_parameters(params, &warnings);
+  EXPECT_EQ(both.odometry.estimator.ransac.point_threshold_px, 2.0);
+  EXPECT_TRUE(both.odometry.estimator.use_junction_points);
+}
+
+TEST(NodeParameters, BadValuesAndUnknownNamesAreReportedAndKeepTheDefault) {
+  const NodeParameters defaults;
+  struct Bad {
+    std::string name;
+    XmlRpcValue value;
+    std::string says;
+  };
+  const std::vector<Bad> bad = {
+      {"vp_min_inliers", 1, "must be >= 2"},
+      {"klt_window_px", 3, "must be >= 5"},
+      {"frame_queue_size", 0, "must be >= 1"},
+      {"rectified_fov_deg", 5.0, "must be in [10, 170]"},
+      {"max_frame_gap", 0.0, "must be > 0"},
+      {"point_threshold_px", -1.0, "must be > 0"},
+      {"image_transport", "theora", "'theora' unknown"},
+      {"preset", "6pc", "'6pc' unknown"},
+      {"stereo", "yes", "expected a boolean"},
+      {"max_features", "many", "expected an integer"},
+  };
+  for (const Bad& b : bad) {
+    std::vector<std::string> warnings;
+    const NodeParameters p = read_one(b.name, b.value, &warnings);
+    ASSERT_EQ(warnings.size(), 1u) << b.name;
+    EXPECT_EQ(warnings[0].rfind(b.name + ": ", 0), 0u) << warnings[0];
+    EXPECT_NE(warnings[0].find(b.says), std::string::npos) << warnings[0];
+    EXPECT_EQ(p.odometry.estimator.vp_detection.min_inliers, 6);
+    EXPECT_EQ(p.odometry.klt.window_px, defaults.odometry.klt.window_px);
+    EXPECT_EQ(p.frame_queue_size, 1);
+    EXPECT_EQ(p.rectified_fov_deg, 100.0);
+    EXPECT_FALSE(p.stereo || p.compressed);
+    EXPECT_EQ(p.preset, "hybrid");
+  }
+  std::vector<std::string> warnings;
+  read_one("point_treshold_px", 2.0, &warnings);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], "point_treshold_px: not a parameter of the node");
+  // As roscpp reads them: an integer where a number is expected, a number rounded to an integer.
+  warnings.clear();
+  EXPECT_EQ(read_one("mono_scale", 2, &warnings).odometry.mono_scale, 2.0);
+  EXPECT_EQ(read_one("max_features", 499.6, &warnings).odometry.features.points.max_features, 500);
+  EXPECT_TRUE(warnings.empty());
+}
+
+TEST(OptionFields, ValidateNamesTheFirstFieldOutOfBounds) {
+  TwoViewOptions options;
+  EXPECT_EQ(validate(options), "");
+  options.ransac.confidence = 1.0;
+  EXPECT_EQ(validate(options), "confidence: must be in (0, 1), got 1");
+  options.ransac.confidence = 0.99;
+  options.junctions.tolerance_px = -1.0;
+  EXPECT_EQ(validate(options), "junctions_tolerance_px: must be >= 0, got -1");
+  options.junctions.tolerance_px = 3.0;
+  options.ransac.prior[3] = -2.0;
+  EXPECT_EQ(validate(options), "prior[3]: must be >= 0, got -2");
+  options.ransac.prior[3] = 1.0;
+  options.vp_detection.inlier_threshold_px = std::nan("");
+  EXPECT_EQ(validate(options), "vp_detection_inlier_threshold_px: must be > 0, got nan");
+}
+
+}  // namespace
+}  // namespace hybrid_vo
