@@ -193,7 +193,7 @@ double direct_median(const std::string& output, const std::string& label) {
 // On the shared KITTI frames when present: --trajectory writes every frame's pose, and
 // --direct-gap compares the odometry's and the truth's rotations over G frames with direct
 // two-view estimates. KITTI's truth is known to be 3-5 times further from them than the
-// odometry (README, "Through the node").
+// odometry (doc/vanishing_points.md, "Through the node").
 TEST(BenchFrontendCli, TrajectoryAndDirectCheck) {
   const std::string data = shared_kitti();
   if (!std::ifstream(data + "/sequences/seq0x/times.txt")) GTEST_SKIP() << data << " not present";

@@ -1,4 +1,4 @@
-// Which folder may include which, checked on the sources themselves (README, Layout).
+// Which folder may include which, checked on the sources themselves (doc/development.md, Layout).
 //   - The core (geometry, solvers, estimation, lines, synthetic) links Eigen and Ceres only, and
 //     each layer includes only the layers before it (DESIGN.md: geometry <- solvers <- estimation
 //     <- lines <- frontend <- node); synthetic data may use all of the core.

@@ -19,6 +19,7 @@ estimator pixels; segments are their endpoints (x1, y1, x2, y2); VPs are directi
 Arrays are float64 and C-contiguous; malformed input raises ValueError naming the argument.
 """
 
+import inspect as _inspect
 import sys as _sys
 
 from . import _core
@@ -26,25 +27,64 @@ from ._core import (  # noqa: F401  (re-exported)
     estimator_options,
     pose_error_deg,
     presets,
-    relpose_1vp_2line_1pt,
-    relpose_1vp_2pt_orth,
-    relpose_1vp_3line,
-    relpose_1vp_3pt,
-    relpose_1vp_orthline_2pt,
-    relpose_2pt_3line,
-    relpose_2vp_2pt,
-    relpose_5pt,
-    relpose_homography_1pt_3line,
-    relpose_homography_2pt_2line,
-    relpose_homography_3pt_1line,
-    relpose_homography_4line,
-    relpose_homography_4pt,
     sampson_errors_px,
     solve_minimal,
     solvers,
     synthetic,
     vp_detection_options,
 )
+
+# What each solver does beyond its inputs (solvers() has those), for its docstring.
+_SOLVER_DETAILS = {
+    "5-0-0": "Nister's five-point essential matrix, decomposed.",
+    "4-0-0": "Homography by DLT from coplanar points, decomposed.",
+    "3-1-0": "Points and segment on one plane; lines map as l1 ~ H^T l2.",
+    "2-2-0": "Degenerate for every input (a one-parameter family of homographies fits; "
+             "doc/solvers.md): it always returns an empty list, and is listed for completeness.",
+    "1-3-0": "Point and segments on one plane; homography by DLT.",
+    "0-4-0": "Four coplanar segments; homography by DLT.",
+    "2-3-0": "The three junctions of the coplanar segments complete five points.",
+    "3-0-1": "Upright three-point after rotating the VP onto the y-axis.",
+    "0-3-1": "Coplanar segments, whose junctions are the points of 3-0-1.",
+    "2-0-2": "Rotation from the two VPs (row k of v1 matches row k of v2).",
+    "2-1-1p": "The segment's 3D line is orthogonal to the VP.",
+    "1-2-1p": "Intersecting segments, the first orthogonal to the VP.",
+    "2-0-1p": "The points' 3D line is orthogonal to the VP.",
+}
+
+
+def _solver_function(info):
+    """The solver's own function, with the C++ name and argument order (VPs, segments, points for
+    the VP solvers; points, then segments for the others), run by the C++ dispatcher."""
+    vps, lines, points = info["num_vps"], info["num_lines"], info["num_points"]
+    names = (["v1", "v2"] * (vps > 0) + ["x1", "x2"] * (vps == 0 < points)
+             + ["s1", "s2"] * (lines > 0) + ["x1", "x2"] * (vps > 0 < points))
+    sign = {0: None, 1: "vp_sign_known", 2: "vp_signs_known"}[vps]
+    P = _inspect.Parameter
+    signature = _inspect.Signature([P(n, P.POSITIONAL_OR_KEYWORD) for n in names] + (
+        [P(sign, P.POSITIONAL_OR_KEYWORD, default=False)] if sign else []))
+
+    def solver(*args, **kwargs):
+        given = signature.bind(*args, **kwargs).arguments
+        known = given.pop(sign, False) if sign else False
+        return _core._solve(info["function"], sign or "", known, **given)
+
+    solver.__name__ = solver.__qualname__ = info["function"]
+    solver.__signature__ = signature
+    solver.__doc__ = (
+        f"{info['code']}: {info['inputs']} (paper Fig. 2). {_SOLVER_DETAILS[info['ascii_code']]}\n"
+        + (f"With {sign}, v2 = +R v1; otherwise the sign v2 = -R v1 is tried too.\n" if sign else "")
+        + "Points are normalised image coordinates (K^-1 x) as N x 2 float64 arrays, segments their "
+        "two endpoints\nas N x 4 (x1, y1, x2, y2), VPs directions (K^-1 v, any scale) as 3-vectors "
+        "(N x 3 for two); a\nsingle point or segment may be 1-D. Returns a list of (R, t) with "
+        "X2 = R X1 + t and unit t (t = 0\nfor a pure rotation), every real solution with all points "
+        "and segments in front of both cameras;\nan empty list for degenerate input. Raises "
+        "ValueError for wrong shapes, dtypes, strides or\nnon-finite values.")
+    return solver
+
+
+for _info in solvers():
+    globals()[_info["function"]] = _solver_function(_info)
 
 # The generators live in the extension as a submodule; make `import hybrid_vo.synthetic` work.
 _sys.modules[__name__ + ".synthetic"] = synthetic
@@ -180,11 +220,11 @@ def detect_vanishing_points(*args, mode="joint", **options):
     if set(given) == set(names1):
         if mode != "joint":
             raise ValueError("mode: only for two views (camera1, camera2, segments1, segments2)")
-        return _core._detect_vanishing_points_single(given["camera"], given["segments"], **options)
+        return _core._detect_vanishing_points(given["camera"], given["segments"], None, None, mode,
+                                              **options)
     if set(given) == set(names2):
-        return _core._detect_vanishing_points_two_view(
-            given["camera1"], given["camera2"], given["segments1"], given["segments2"], mode,
-            **options)
+        return _core._detect_vanishing_points(given["camera1"], given["segments1"],
+                                              given["camera2"], given["segments2"], mode, **options)
     raise TypeError(
         "detect_vanishing_points takes (camera, segments) or "
         f"(camera1, camera2, segments1, segments2); got {sorted(given)}")
@@ -196,14 +236,3 @@ def __getattr__(name):
         from .frontend import match_image_pair
         return match_image_pair
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-__all__ = [
-    "RelativePoseEstimate", "detect_vanishing_points", "estimate_relative_pose",
-    "estimator_options", "match_image_pair", "pose_error_deg", "presets",
-    "relpose_1vp_2line_1pt", "relpose_1vp_2pt_orth", "relpose_1vp_3line", "relpose_1vp_3pt",
-    "relpose_1vp_orthline_2pt", "relpose_2pt_3line", "relpose_2vp_2pt", "relpose_5pt",
-    "relpose_homography_1pt_3line", "relpose_homography_2pt_2line",
-    "relpose_homography_3pt_1line", "relpose_homography_4line", "relpose_homography_4pt",
-    "sampson_errors_px", "solve_minimal", "solvers", "synthetic", "vp_detection_options",
-]

@@ -14,7 +14,7 @@ class ModelScorer {
  public:
   // A VP residual is an angle in two directions: it counts as two rows, each normalised by its
   // threshold like a point's one row. (It was a tuned weight of 3 points; measured on the four pair
-  // sets at gaps 1-3 with 10 runs, 2 rows is as good: README, "Lines and VPs on real data".)
+  // sets at gaps 1-3 with 10 runs, 2 rows is as good: doc/pairs.md, "The knobs that stay".)
   static constexpr double kVpRows = 2.0;
 
   ModelScorer(const HybridProblem& problem, double point_threshold_px, double vp_threshold_rad);

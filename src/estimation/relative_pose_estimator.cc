@@ -260,7 +260,7 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
   // The VPs without a prior are the pair's own evidence, like its points: weakened alike, they
   // keep the balance of the first refinement. The segments of a VP with a prior carry it into
   // the rotation and keep their sigma (weakened too, they cost the rendered corridor 2.3 -> 10.7
-  // deg/100 m; README, "Lines and VPs on real data").
+  // deg/100 m; doc/vanishing_points.md).
   data.vp_sigma_scale.assign(data.vps.size(), 1.0);
   for (size_t j = 0; j < data.vps.size(); ++j)
     if (!data.vp_priors[j].valid) data.vp_sigma_scale[j] = dependence;

@@ -49,7 +49,7 @@ bool uses_vps(const RelativePoseEstimatorOptions& options) {
 VisualOdometryOptions::VisualOdometryOptions() {
   features.points = video_point_matching_options();
   features.lines = video_line_matching_options();
-  // Low texture (issue 30, README "Low texture"): a VP may rest on three long segments, and
+  // Low texture (issue 30, doc/low_texture.md): a VP may rest on three long segments, and
   // segments that stop short of a corner still meet.
   estimator.vp_detection.min_long_inliers = 3;
   estimator.vp_detection.min_support_px = 150.0;

@@ -1,6 +1,5 @@
-// The minimal solvers (paper Fig. 2): one Python function per C++ function, generated from the
-// solver table (its inputs give the arguments), the dispatcher solve_minimal, the table itself,
-// and pose errors.
+// The minimal solvers (paper Fig. 2) through the dispatcher the hybrid RANSAC uses (the package
+// makes one function per solver from the table), the solver table, and pose errors.
 #include <map>
 
 #include "bindings.h"
@@ -29,21 +28,6 @@ Eigen::Matrix3d rotation_argument(py::handle value, const char* name) {
 
 Eigen::Vector3d translation_argument(py::handle value, const char* name) {
   return MatrixArgument(value, name, 3, 1).vector3(0);
-}
-
-// The Python parameter names of a solver, in its C++ argument order: VPs, segments, points for
-// the VP solvers, points then segments for the others; and its sign keyword (or "").
-std::vector<std::string> solver_parameters(const SolverInfo& info, std::string* sign_keyword) {
-  std::vector<std::string> names;
-  auto add = [&](bool present, const char* a, const char* b) {
-    if (present) names.insert(names.end(), {a, b});
-  };
-  add(info.num_vps > 0, "v1", "v2");
-  add(info.num_vps == 0 && info.num_points > 0, "x1", "x2");
-  add(info.num_lines > 0, "s1", "s2");
-  add(info.num_vps > 0 && info.num_points > 0, "x1", "x2");
-  *sign_keyword = info.num_vps == 2 ? "vp_signs_known" : info.num_vps == 1 ? "vp_sign_known" : "";
-  return names;
 }
 
 // The minimal sample of `info` from its arguments by name (x1, x2, s1, s2, v1, v2), as the C++
@@ -92,85 +76,29 @@ MinimalSample read_sample(const SolverInfo& info, const std::map<std::string, py
   return sample;
 }
 
-// What each solver does beyond its inputs, for its docstring.
-const std::map<SolverId, const char*> kSolverDetails = {
-    {SolverId::k5pt, "Nister's five-point essential matrix, decomposed."},
-    {SolverId::kHomography4pt, "Homography by DLT from coplanar points, decomposed."},
-    {SolverId::kHomography3pt1l, "Points and segment on one plane; lines map as l1 ~ H^T l2."},
-    {SolverId::kHomography2pt2l,
-     "Degenerate for every input (a one-parameter family of homographies fits;\nREADME): it "
-     "always returns an empty list, and is listed for completeness."},
-    {SolverId::kHomography1pt3l, "Point and segments on one plane; homography by DLT."},
-    {SolverId::kHomography4l, "Four coplanar segments; homography by DLT."},
-    {SolverId::k2pt3line, "The three junctions of the coplanar segments complete five points."},
-    {SolverId::k1vp3pt, "Upright three-point after rotating the VP onto the y-axis."},
-    {SolverId::k1vp3line, "Coplanar segments, whose junctions are the points of 3-0-1."},
-    {SolverId::k2vp2pt, "Rotation from the two VPs (row k of v1 matches row k of v2)."},
-    {SolverId::k1vpOrthline2pt, "The segment's 3D line is orthogonal to the VP."},
-    {SolverId::k1vp2line1pt, "Intersecting segments, the first orthogonal to the VP."},
-    {SolverId::k1vp2ptOrth, "The points' 3D line is orthogonal to the VP."},
-};
-
-// The docstring of a solver: signature, configuration, inputs, and the shared conventions.
-std::string solver_doc(const SolverInfo& info, const std::vector<std::string>& names,
-                       const std::string& sign_keyword) {
-  std::string signature;
-  for (const std::string& name : names) signature += (signature.empty() ? "" : ", ") + name;
-  if (!sign_keyword.empty()) signature += ", " + sign_keyword + "=False";
-  return std::string(info.function) + "(" + signature + ")\n--\n\n" + info.code + ": " +
-         info.inputs + " (paper Fig. 2).\n\n" + kSolverDetails.at(info.id) +
-         (sign_keyword.empty() ? "" : "\nWith " + sign_keyword +
-                                          ", v2 = +R v1; otherwise the sign v2 = -R v1 is tried "
-                                          "too.") +
-         "\nPoints are normalised image coordinates (K^-1 x) as N x 2 float64 arrays, segments "
-         "their two\nendpoints as N x 4 (x1, y1, x2, y2), VPs directions (K^-1 v, any scale) as "
-         "3-vectors (N x 3\nfor two); a single point or segment may be 1-D. Index 1 is the first "
-         "image, 2 the second.\nReturns a list of (R, t) with X2 = R X1 + t and unit t (t = 0 for "
-         "a pure rotation), every real\nsolution with all points and segments in front of both "
-         "cameras; an empty list for degenerate\ninput. Raises ValueError for wrong shapes, "
-         "dtypes, strides or non-finite values.";
-}
-
-// Binds the solver under its C++ name and argument order; it runs through the dispatcher that
-// the hybrid RANSAC uses (solve_minimal), which calls the same function.
-void def_solver(py::module_& m, const SolverInfo& info) {
-  std::string sign_keyword;
-  const std::vector<std::string> names = solver_parameters(info, &sign_keyword);
-  m.def(
-      info.function,
-      [&info, names, sign_keyword](const py::args& args, const py::kwargs& kwargs) {
-        const std::string function = info.function;
-        if (args.size() > names.size() + (sign_keyword.empty() ? 0 : 1))
-          throw py::type_error(function + "() takes " + std::to_string(names.size()) +
-                               " positional arguments");
-        std::map<std::string, py::handle> given;
-        for (size_t k = 0; k < args.size(); ++k)
-          given[k < names.size() ? names[k] : sign_keyword] = args[k];
-        for (const auto& item : kwargs) {
-          const std::string name = py::str(item.first);
-          if (std::find(names.begin(), names.end(), name) == names.end() && name != sign_keyword)
-            throw py::type_error(function + "() got an unexpected keyword argument '" + name + "'");
-          if (given.count(name)) throw py::type_error(function + "() got multiple values for '" + name + "'");
-          given[name] = item.second;
-        }
-        for (const std::string& name : names)
-          if (!given.count(name))
-            throw py::type_error(function + "() missing required argument '" + name + "'");
-        MinimalSample sample = read_sample(info, given, false);
-        const auto known = given.find(sign_keyword);
-        sample.vp_signs_known =
-            known != given.end() && bool_argument(known->second, sign_keyword);
-        RelativePoses poses;
-        solve_minimal(info.id, sample, &poses);
-        return poses_to_list(poses);
-      },
-      solver_doc(info, names, sign_keyword).c_str());
+py::list solve(const SolverInfo& info, const MinimalSample& sample) {
+  RelativePoses poses;
+  solve_minimal(info.id, sample, &poses);
+  return poses_to_list(poses);
 }
 
 }  // namespace
 
 void bind_solvers(py::module_& m) {
-  for (const SolverInfo& info : solver_table()) def_solver(m, info);
+  // The solvers' own functions (python/hybrid_vo/__init__.py makes them from solvers()): their
+  // arrays by keyword, None read as a bad array.
+  m.def(
+      "_solve",
+      [](py::handle solver, const std::string& sign_keyword, py::handle known,
+         const py::kwargs& arrays) {
+        const SolverInfo& info = solver_info(solver_argument(solver, "solver"));
+        std::map<std::string, py::handle> given;
+        for (const auto& item : arrays) given[py::str(item.first)] = item.second;
+        MinimalSample sample = read_sample(info, given, false);
+        sample.vp_signs_known = bool_argument(known, sign_keyword);
+        return solve(info, sample);
+      },
+      "_solve(solver, sign_keyword, known, **arrays)\n--\n\nA solver's own function.");
 
   m.def(
       "solve_minimal",
@@ -180,9 +108,7 @@ void bind_solvers(py::module_& m) {
         MinimalSample sample = read_sample(
             info, {{"x1", x1}, {"x2", x2}, {"s1", s1}, {"s2", s2}, {"v1", v1}, {"v2", v2}}, true);
         sample.vp_signs_known = bool_argument(known, "vp_signs_known");
-        RelativePoses poses;
-        solve_minimal(info.id, sample, &poses);
-        return poses_to_list(poses);
+        return solve(info, sample);
       },
       "solver"_a, "x1"_a = py::none(), "x2"_a = py::none(), "s1"_a = py::none(),
       "s2"_a = py::none(), "v1"_a = py::none(), "v2"_a = py::none(), "vp_signs_known"_a = false,

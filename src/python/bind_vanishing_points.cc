@@ -33,40 +33,34 @@ py::list index_lists(const std::vector<std::vector<int>>& lists) {
 }  // namespace
 
 void bind_vanishing_points(py::module_& m) {
+  // One image (camera2 and segments2 None) or two; hybrid_vo.detect_vanishing_points reads its
+  // arguments and calls this.
   m.def(
-      "_detect_vanishing_points_single",
-      [](py::handle camera, py::handle segments, const py::kwargs& kwargs) {
-        const PinholeCamera c = camera_argument(camera, "camera");
-        const std::vector<LineSegment> s = read_segments(segments, "segments");
-        const VpDetectionOptions options = read_options(kwargs, "detect_vanishing_points");
-        SingleImageVps vps;
-        {
-          py::gil_scoped_release release;
-          vps = detect_vanishing_points(c, s, options);
-        }
-        std::vector<Eigen::Vector3d> directions;
-        std::vector<std::vector<int>> inliers;
-        std::vector<double> scores;
-        for (const ImageVp& vp : vps.vps) {
-          directions.push_back(vp.direction);
-          inliers.push_back(vp.inliers);
-          scores.push_back(vp.score);
-        }
-        return py::dict("directions"_a = directions_to_array(directions),
-                        "labels"_a = to_int_array(vps.labels), "inliers"_a = index_lists(inliers),
-                        "scores"_a = py::array_t<double>(scores.size(), scores.data()));
-      },
-      "camera"_a, "segments"_a,
-      "_detect_vanishing_points_single(camera, segments, **options)\n--\n\n"
-      "Single-image VP detection; see hybrid_vo.detect_vanishing_points.");
-
-  m.def(
-      "_detect_vanishing_points_two_view",
-      [](py::handle camera1, py::handle camera2, py::handle segments1, py::handle segments2,
+      "_detect_vanishing_points",
+      [](py::handle camera1, py::handle segments1, py::handle camera2, py::handle segments2,
          py::handle mode, const py::kwargs& kwargs) {
-        const PinholeCamera c1 = camera_argument(camera1, "camera1");
+        const bool two = !camera2.is_none();
+        const char* names[] = {two ? "camera1" : "camera", two ? "segments1" : "segments"};
+        const PinholeCamera c1 = camera_argument(camera1, names[0]);
+        const std::vector<LineSegment> s1 = read_segments(segments1, names[1]);
+        const VpDetectionOptions options = read_options(kwargs, "detect_vanishing_points");
+        std::vector<Eigen::Vector3d> d1, d2;
+        std::vector<char> known;
+        if (!two) {
+          SingleImageVps vps;
+          {
+            py::gil_scoped_release release;
+            vps = detect_vanishing_points(c1, s1, options);
+          }
+          std::vector<std::vector<int>> inliers;
+          std::vector<double> scores;
+          for (const ImageVp& vp : vps.vps)
+            d1.push_back(vp.direction), inliers.push_back(vp.inliers), scores.push_back(vp.score);
+          return py::dict("directions"_a = directions_to_array(d1),
+                          "labels"_a = to_int_array(vps.labels), "inliers"_a = index_lists(inliers),
+                          "scores"_a = py::array_t<double>(scores.size(), scores.data()));
+        }
         const PinholeCamera c2 = camera_argument(camera2, "camera2");
-        const std::vector<LineSegment> s1 = read_segments(segments1, "segments1");
         const std::vector<LineSegment> s2 = read_segments(segments2, "segments2");
         if (s1.size() != s2.size())
           throw_value_error("segments2", std::to_string(s2.size()) + " rows, but segments1 has " +
@@ -75,7 +69,6 @@ void bind_vanishing_points(py::module_& m) {
         if (m != "joint" && m != "standard")
           throw_value_error("mode",
                             "expected 'joint' or 'standard', got " + std::string(py::repr(mode)));
-        const VpDetectionOptions options = read_options(kwargs, "detect_vanishing_points");
         std::vector<LineMatch> lines(s1.size());
         for (size_t i = 0; i < s1.size(); ++i) lines[i] = {s1[i], s2[i]};
         MatchedVps vps;
@@ -84,22 +77,17 @@ void bind_vanishing_points(py::module_& m) {
           vps = m == "joint" ? detect_vanishing_points_joint(c1, c2, lines, options)
                              : detect_vanishing_points_standard(c1, c2, lines, options);
         }
-        std::vector<Eigen::Vector3d> d1, d2;
-        std::vector<char> known;
-        for (const VpMatch& vp : vps.matches) {
-          d1.push_back(vp.d1);
-          d2.push_back(vp.d2);
-          known.push_back(vp.sign_known);
-        }
+        for (const VpMatch& vp : vps.matches)
+          d1.push_back(vp.d1), d2.push_back(vp.d2), known.push_back(vp.sign_known);
         return py::dict("vps"_a = py::make_tuple(directions_to_array(d1), directions_to_array(d2)),
                         "vp_signs_known"_a = to_bool_array(known),
                         "line_vp"_a = to_int_array(vps.labels),
                         "inliers"_a = index_lists(vps.inliers),
                         "scores"_a = py::array_t<double>(vps.scores.size(), vps.scores.data()));
       },
-      "camera1"_a, "camera2"_a, "segments1"_a, "segments2"_a, "mode"_a = "joint",
-      "_detect_vanishing_points_two_view(camera1, camera2, segments1, segments2, mode='joint', "
-      "**options)\n--\n\nTwo-view VP detection; see hybrid_vo.detect_vanishing_points.");
+      "camera1"_a, "segments1"_a, "camera2"_a, "segments2"_a, "mode"_a,
+      "_detect_vanishing_points(camera1, segments1, camera2, segments2, mode, **options)\n--\n\n"
+      "VP detection; see hybrid_vo.detect_vanishing_points.");
 
   m.def(
       "vp_detection_options", [] { return options_dict(VpDetectionOptions()); },

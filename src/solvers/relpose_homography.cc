@@ -168,7 +168,7 @@ bool homography_from_points_and_lines(const Eigen::Vector2d* x1, const Eigen::Ve
                                       int num_points, const LineSegment* s1, const LineSegment* s2,
                                       int num_lines, Eigen::Matrix3d* H) {
   if (num_points < 0 || num_lines < 0 || num_points + num_lines != 4) return false;
-  // Two points and two lines never fix H (README, "2-2-0 is degenerate").
+  // Two points and two lines never fix H (doc/solvers.md, "2-2-0 is degenerate").
   if (num_points == 2) return false;
   if (num_points == 4) return homography_4pt(x1, x2, H);
   // Centred coordinates (as HZ2004 Sec. 4.4.4 normalises the DLT): the cross products then do

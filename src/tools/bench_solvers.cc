@@ -182,7 +182,7 @@ Row bench_solver(const SolverInfo& info, const std::vector<MinimalInstance>& dat
     sink += solve_minimal(info.id, data[i].sample, &scratch);
   });
   // Capacity reserved before the calls, as for the timed ones: callgrind's count of solve_minimal
-  // (README) then holds the solvers' work, not the vectors' growth.
+  // (doc/solvers.md) then holds the solvers' work, not the vectors' growth.
   std::vector<RelativePoses> solutions(data.size());
   for (size_t i = 0; i < data.size(); ++i) {
     solutions[i].reserve(16);

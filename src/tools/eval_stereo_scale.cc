@@ -392,7 +392,7 @@ int main(int argc, char** argv) {
       {"calibrated", calibrated(0.0)},
       // Softer than the hard limit: a farther one, or the offset left free in each pair's fit
       // around the calibrated one with a prior sigma (px), which discounts the far points'
-      // scale information by how well the offset is known (README, "Stereo scale").
+      // scale information by how well the offset is known (doc/stereo_scale.md).
       {"cal<60b", calibrated(60.0)},
       {"cal+p0.1", calibrated(0.0, 0.1)},
       {"cal+p0.2", calibrated(0.0, 0.2)},

@@ -36,11 +36,8 @@ struct JunctionOptions {
 
 template <typename Visit>
 void visit_fields(JunctionOptions& o, Visit&& visit) {
-  visit("tolerance_px", o.tolerance_px, non_negative());
-  visit("length_fraction", o.length_fraction, non_negative());
-  visit("max_tolerance_px", o.max_tolerance_px, non_negative());
-  visit("min_angle_deg", o.min_angle_deg, non_negative());
-  visit("duplicate_px", o.duplicate_px, non_negative());
+  HYBRID_VO_FIELDS(non_negative(), o.tolerance_px, o.length_fraction, o.max_tolerance_px,
+                  o.min_angle_deg, o.duplicate_px);
 }
 
 // Junctions of segment matches (paper supp. Sec. B): pairs whose intersection lies on both

@@ -64,18 +64,11 @@ struct FinalRefinementOptions {
 
 template <typename Visit>
 void visit_fields(FinalRefinementOptions& o, Visit&& visit) {
-  visit("enabled", o.enabled);
-  visit("point_sigma_px", o.point_sigma_px);
-  visit("line_vp_sigma_px", o.line_vp_sigma_px);
-  visit("vp_sigma_deg", o.vp_sigma_deg);
-  visit("point_loss_px", o.point_loss_px);
-  visit("line_vp_loss_px", o.line_vp_loss_px);
-  visit("vp_loss_deg", o.vp_loss_deg);
-  visit("refine_vp_directions", o.refine_vp_directions);
-  visit("max_iterations", o.max_iterations, non_negative());
-  visit("compute_covariance", o.compute_covariance);
-  visit("function_tolerance", o.function_tolerance, positive());
-  visit("parameter_tolerance", o.parameter_tolerance, positive());
+  HYBRID_VO_FIELDS(any_value(), o.enabled, o.point_sigma_px, o.line_vp_sigma_px, o.vp_sigma_deg,
+                  o.point_loss_px, o.line_vp_loss_px, o.vp_loss_deg, o.refine_vp_directions,
+                  o.compute_covariance);
+  HYBRID_VO_FIELDS(non_negative(), o.max_iterations);
+  HYBRID_VO_FIELDS(positive(), o.function_tolerance, o.parameter_tolerance);
 }
 
 // The refinement's data: inliers of the estimate.

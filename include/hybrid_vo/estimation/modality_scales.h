@@ -42,7 +42,7 @@ struct ModalityScaleOptions {
   // the 90th percentile, on both KITTI and the rendered corridor. Against a VP prior, which
   // carries many frames, the point-like matches of a pair therefore count as at most this many
   // independent ones (sigma times sqrt(n / this)), in the prior's gate and in the refinement with
-  // it. Measured through the odometry (README, "Lines and VPs on real data"): 16 keeps KITTI
+  // it. Measured through the odometry (doc/vanishing_points.md): 16 keeps KITTI
   // within 0.01 deg/100 m of unlimited points and takes the rendered corridor from 21 to 3
   // deg/100 m. A pair alone keeps the measured sigmas: at 16 the Strecha pairs at gaps 2 and 3
   // lost 0.1-0.3 AUC@10 to 5pc.
@@ -51,18 +51,11 @@ struct ModalityScaleOptions {
 
 template <typename Visit>
 void visit_fields(ModalityScaleOptions& o, Visit&& visit) {
-  visit("enabled", o.enabled);
-  visit("min_points", o.min_points, non_negative());
-  visit("min_junctions", o.min_junctions, non_negative());
-  visit("min_lines", o.min_lines, non_negative());
-  visit("min_vps", o.min_vps, non_negative());
-  visit("inlier_multiple", o.inlier_multiple, positive());
-  visit("line_threshold_px", o.line_threshold_px, positive());
-  visit("default_fraction", o.default_fraction, positive());
-  visit("min_point_px", o.min_point_px, non_negative());
-  visit("min_line_px", o.min_line_px, non_negative());
-  visit("min_vp_deg", o.min_vp_deg, non_negative());
-  visit("max_independent_points", o.max_independent_points, positive());
+  HYBRID_VO_FIELDS(any_value(), o.enabled);
+  HYBRID_VO_FIELDS(non_negative(), o.min_points, o.min_junctions, o.min_lines, o.min_vps,
+                  o.min_point_px, o.min_line_px, o.min_vp_deg);
+  HYBRID_VO_FIELDS(positive(), o.inlier_multiple, o.line_threshold_px, o.default_fraction,
+                  o.max_independent_points);
 }
 
 // Robust standard deviation per axis of zero-mean Gaussian residuals from their magnitudes: the

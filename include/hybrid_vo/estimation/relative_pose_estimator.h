@@ -46,7 +46,7 @@ struct HybridRansacOptions {
   // together have missed an all-inlier sample with probability below 1 - confidence, but not
   // before min_iterations. VP solvers reach that bound within a few draws, yet an all-inlier
   // sample of noisy VPs can still give a wrong translation in forward motion (KITTI): 150 draws
-  // fixed every such pair on KITTI at ~1 ms (README).
+  // fixed every such pair on KITTI at ~1 ms (doc/pairs.md).
   double confidence = 0.999;
   int min_iterations = 150;
   int max_iterations = 5000;
@@ -64,23 +64,14 @@ struct HybridRansacOptions {
 
 template <typename Visit>
 void visit_fields(HybridRansacOptions& o, Visit&& visit) {
-  visit("enabled", o.enabled);
-  visit("prior", o.prior, non_negative());
-  visit("point_threshold_px", o.point_threshold_px, positive());
-  visit("vp_threshold_deg", o.vp_threshold_deg, positive());
-  visit("line_inlier_ratio", o.line_inlier_ratio, fraction());
-  visit("initial_point_inlier_ratio", o.initial_point_inlier_ratio, fraction());
-  visit("initial_vp_inlier_ratio", o.initial_vp_inlier_ratio, fraction());
-  visit("exploration", o.exploration, fraction());
-  visit("five_point_share", o.five_point_share, fraction());
-  visit("confidence", o.confidence, open_fraction());
-  visit("min_iterations", o.min_iterations, non_negative());
-  visit("max_iterations", o.max_iterations, positive());
-  visit("local_optimization", o.local_optimization);
-  visit("lo_max_points", o.lo_max_points, positive());
-  visit("lo_rounds", o.lo_rounds, non_negative());
-  visit("orthogonal_tolerance_deg", o.orthogonal_tolerance_deg, non_negative());
-  visit("seed", o.seed);
+  HYBRID_VO_FIELDS(any_value(), o.enabled, o.local_optimization, o.seed);
+  HYBRID_VO_FIELDS(non_negative(), o.prior, o.min_iterations, o.lo_rounds,
+                  o.orthogonal_tolerance_deg);
+  HYBRID_VO_FIELDS(positive(), o.point_threshold_px, o.vp_threshold_deg, o.max_iterations,
+                  o.lo_max_points);
+  HYBRID_VO_FIELDS(fraction(), o.line_inlier_ratio, o.initial_point_inlier_ratio,
+                  o.initial_vp_inlier_ratio, o.exploration, o.five_point_share);
+  HYBRID_VO_FIELDS(open_fraction(), o.confidence);
 }
 
 struct RelativePoseEstimatorOptions {
@@ -108,16 +99,14 @@ struct RelativePoseEstimatorOptions {
 template <typename Visit>
 void visit_fields(RelativePoseEstimatorOptions& o, Visit&& visit) {
   visit_fields(o.ransac, visit);
-  visit("use_junction_points", o.use_junction_points);
-  visit("use_endpoint_points", o.use_endpoint_points);
+  HYBRID_VO_FIELDS(any_value(), o.use_junction_points, o.use_endpoint_points);
   visit_fields(o.junctions, prefixed("junctions_", visit));
   // The sigmas and losses are set from the scales and thresholds above.
   visit_fields(o.refinement, prefixed("refinement_", visit,
                                       {"point_sigma_px", "line_vp_sigma_px", "vp_sigma_deg",
                                        "point_loss_px", "line_vp_loss_px", "vp_loss_deg"}));
   visit_fields(o.scales, prefixed("scales_", visit));
-  visit("vp_prior_gate_chi2", o.vp_prior_gate_chi2, non_negative());
-  visit("min_point_inliers", o.min_point_inliers, non_negative());
+  HYBRID_VO_FIELDS(non_negative(), o.vp_prior_gate_chi2, o.min_point_inliers);
 }
 
 // The paper's table rows: "5pc", "5pc+junc", "5pc+4pc", "5pc+4pc+junc", "hybrid", "hybrid+junc".

@@ -25,7 +25,7 @@ struct KltTrackerOptions {
   double min_corner_gradient = 0.0;
   // Lucas-Kanade's cost grows with the window's area: 11 px costs about a quarter of 21 px, and
   // through the odometry it is as accurate or better on KITTI 01 (AUC@10 95.96 against 95.83)
-  // and the rendered corridor (ATE 0.0104 against 0.0176 m) (README, "The VO node").
+  // and the rendered corridor (ATE 0.0104 against 0.0176 m) (doc/vanishing_points.md).
   int window_px = 11;
   int pyramid_levels = 3;
   double max_forward_backward_px = 1.0;  // forward-backward check of each track
@@ -37,7 +37,7 @@ struct KltTrackerOptions {
   // search loses is searched for again the long way. The backward search of the
   // forward-backward check mirrors the forward one: it starts at the found position minus the
   // predicted motion. On KITTI this keeps 20 % more tracks that agree with the true epipolar
-  // geometry, half as many that do not, and costs a third less (see the README). Given frame
+  // geometry, half as many that do not, and costs a third less (see doc/performance.md). Given frame
   // stamps, the last motion is scaled by the ratio of the time steps, so that a dropped frame
   // does not start the short search at half the true motion (up to kMaxMotionScale).
   bool predict_motion = true;
@@ -46,17 +46,13 @@ struct KltTrackerOptions {
 
 template <typename Visit>
 void visit_fields(KltTrackerOptions& o, Visit&& visit) {
-  visit("grid_cols", o.grid_cols, positive());
-  visit("grid_rows", o.grid_rows, positive());
-  visit("min_distance_px", o.min_distance_px, non_negative());
-  visit("quality_level", o.quality_level, Bounds{0.0, 1.0, true, false});
-  visit("min_corner_gradient", o.min_corner_gradient, non_negative());
-  visit("window_px", o.window_px, at_least(5));  // smaller windows lose the texture
-  visit("pyramid_levels", o.pyramid_levels, non_negative());
-  visit("max_forward_backward_px", o.max_forward_backward_px, positive());
-  visit("max_iterations", o.max_iterations, positive());
-  visit("predict_motion", o.predict_motion);
-  visit("predicted_pyramid_levels", o.predicted_pyramid_levels, non_negative());
+  HYBRID_VO_FIELDS(positive(), o.grid_cols, o.grid_rows, o.max_forward_backward_px,
+                  o.max_iterations);
+  HYBRID_VO_FIELDS(non_negative(), o.min_distance_px, o.min_corner_gradient, o.pyramid_levels,
+                  o.predicted_pyramid_levels);
+  HYBRID_VO_FIELDS(positive_fraction(), o.quality_level);
+  HYBRID_VO_FIELDS(at_least(5), o.window_px);  // smaller windows lose the texture
+  HYBRID_VO_FIELDS(any_value(), o.predict_motion);
 }
 
 // Sparse optical-flow tracking of corners between consecutive video frames, with re-detection in

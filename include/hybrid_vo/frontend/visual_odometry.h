@@ -76,23 +76,17 @@ struct VisualOdometryOptions {
 // the node sets.
 template <typename Visit>
 void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
-  visit("use_lines", o.use_lines);
+  HYBRID_VO_FIELDS(any_value(), o.use_lines, o.track_lines, o.concurrent,
+                  o.stereo_current_disparity, o.stereo_refine_tracks, o.use_vp_tracker,
+                  o.anchor_orientation);
   visit("max_features", o.features.points.max_features, positive());
   visit_fields(o.klt, prefixed("klt_", visit));
-  visit("track_lines", o.track_lines);
-  visit("concurrent", o.concurrent);
   visit_fields(o.estimator, prefixed("estimator_", visit));
-  visit("min_parallax_px", o.min_parallax_px, non_negative());
-  visit("min_point_matches", o.min_point_matches, non_negative());
-  visit("min_line_matches", o.min_line_matches, non_negative());
-  visit("mono_scale", o.mono_scale, positive());
+  HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches,
+                  o.rotation_drift_floor_deg);
+  HYBRID_VO_FIELDS(positive(), o.mono_scale);
   visit("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines, non_negative());
   visit("stereo_offset_calibration", o.stereo_offset.enabled);
-  visit("stereo_current_disparity", o.stereo_current_disparity);
-  visit("stereo_refine_tracks", o.stereo_refine_tracks);
-  visit("use_vp_tracker", o.use_vp_tracker);
-  visit("anchor_orientation", o.anchor_orientation);
-  visit("rotation_drift_floor_deg", o.rotation_drift_floor_deg, non_negative());
 }
 
 // Externally detected features of a frame (e.g. from a learned front end); ids link them across

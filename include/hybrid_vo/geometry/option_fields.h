@@ -3,8 +3,8 @@
 // Option structs declare their fields once, next to the struct, as
 //
 //   template <typename Visit> void visit_fields(HybridRansacOptions& o, Visit&& visit) {
-//     visit("point_threshold_px", o.point_threshold_px, positive());
-//     ...
+//     HYBRID_VO_FIELDS(positive(), o.point_threshold_px, o.vp_threshold_deg);
+//     ...  // = visit("point_threshold_px", o.point_threshold_px, positive()); ...
 //   }
 //
 // (a nested component under a prefix: visit_fields(o.junctions, prefixed("junctions_", visit))).
@@ -21,8 +21,13 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace hybrid_vo {
+
+// In a visit_fields(o, visit) body: the fields o.a, o.b, ... under their own names ("a", "b"),
+// all within `bounds`.
+#define HYBRID_VO_FIELDS(bounds, ...) visit_named(visit, bounds, #__VA_ARGS__, __VA_ARGS__)
 
 // The values a numeric option may take: [min, max], either end open.
 struct Bounds {
@@ -57,6 +62,19 @@ inline Bounds at_least(double min) { return {min, std::numeric_limits<double>::i
 inline Bounds between(double min, double max) { return {min, max}; }
 inline Bounds fraction() { return {0.0, 1.0}; }
 inline Bounds open_fraction() { return {0.0, 1.0, true, true}; }
+inline Bounds positive_fraction() { return {0.0, 1.0, true, false}; }
+
+// Visits each of `fields` under its name in `spelled`, the preprocessor's spelling of the
+// arguments ("o.a, o.b"), within `bounds` (HYBRID_VO_FIELDS).
+template <typename Visit, typename... Fields>
+void visit_named(Visit& visit, const Bounds& bounds, const char* spelled, Fields&... fields) {
+  std::vector<std::string> names;
+  std::istringstream list(spelled);
+  for (std::string name; std::getline(list, name, ',');)
+    names.push_back(name.substr(name.find('.') + 1));  // "o.a" or " o.a" -> "a"
+  size_t k = 0;
+  (visit(names[k++], fields, bounds), ...);
+}
 
 // A visitor that sees a nested component's fields under `prefix`, without those in `excluded`
 // (fields the enclosing code sets itself, which would otherwise be silent no-ops).

@@ -15,7 +15,7 @@ struct TwoViewOptions : RelativePoseEstimatorOptions {
 
   // VPs for pose estimation need more support than the detector's default: on TUM, VP matches
   // with fewer than 20 segments agreed with the ground-truth rotation (2 degrees) in under half
-  // of the cases, and they cost the hybrid presets up to 8 AUC@10 points (README, pair
+  // of the cases, and they cost the hybrid presets up to 8 AUC@10 points (doc/pairs.md, pair
   // evaluation). The VO node sets its own (vp_min_inliers).
   TwoViewOptions() { vp_detection.min_inliers = 15; }
 };
@@ -24,8 +24,7 @@ struct TwoViewOptions : RelativePoseEstimatorOptions {
 template <typename Visit>
 void visit_fields(TwoViewOptions& o, Visit&& visit) {
   visit_fields(static_cast<RelativePoseEstimatorOptions&>(o), visit);
-  visit("detect_vps", o.detect_vps);
-  visit("joint_vp_detection", o.joint_vp_detection);
+  HYBRID_VO_FIELDS(any_value(), o.detect_vps, o.joint_vp_detection);
   visit_fields(o.vp_detection, prefixed("vp_detection_", visit, {"seed"}));
 }
 

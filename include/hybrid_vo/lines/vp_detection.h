@@ -39,20 +39,14 @@ struct VpDetectionOptions {
 
 template <typename Visit>
 void visit_fields(VpDetectionOptions& o, Visit&& visit) {
-  visit("inlier_threshold_px", o.inlier_threshold_px, positive());
-  visit("min_segment_length_px", o.min_segment_length_px, non_negative());
-  visit("max_vps", o.max_vps, non_negative());
-  visit("min_inliers", o.min_inliers, at_least(2));  // two segments make a VP
-  visit("min_long_inliers", o.min_long_inliers, non_negative());
-  visit("min_support_px", o.min_support_px, non_negative());
-  visit("max_iterations", o.max_iterations, non_negative());
-  visit("confidence", o.confidence, open_fraction());
-  visit("merge_angle_deg", o.merge_angle_deg, non_negative());
-  visit("refine", o.refine);
-  visit("manhattan", o.manhattan);
-  visit("manhattan_tolerance_deg", o.manhattan_tolerance_deg, non_negative());
-  visit("sign_agreement", o.sign_agreement, fraction());
-  visit("seed", o.seed);
+  HYBRID_VO_FIELDS(positive(), o.inlier_threshold_px);
+  HYBRID_VO_FIELDS(non_negative(), o.min_segment_length_px, o.max_vps, o.min_long_inliers,
+                  o.min_support_px, o.max_iterations, o.merge_angle_deg,
+                  o.manhattan_tolerance_deg);
+  HYBRID_VO_FIELDS(at_least(2), o.min_inliers);  // two segments make a VP
+  HYBRID_VO_FIELDS(open_fraction(), o.confidence);
+  HYBRID_VO_FIELDS(any_value(), o.refine, o.manhattan, o.seed);
+  HYBRID_VO_FIELDS(fraction(), o.sign_agreement);
 }
 
 // A VP in one image: a unit direction in the camera frame (K^-1 v), its supporting segments, and

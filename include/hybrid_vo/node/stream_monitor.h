@@ -4,7 +4,7 @@
 
 namespace hybrid_vo {
 
-// Faults of an image stream that the node survives (README, "Faults in the stream"), decided per
+// Faults of an image stream that the node survives (doc/reliability.md), decided per
 // frame from its stamp and image size before any processing, without ROS.
 struct StreamMonitorOptions {
   // A frame newer than the last one by more than this (s) starts a new keyframe chain: the motion

@@ -39,24 +39,12 @@ struct ManhattanSceneOptions {
 
 template <typename Visit>
 void visit_fields(ManhattanSceneOptions& o, Visit&& visit) {
-  visit("num_points", o.num_points, non_negative());
-  visit("planar_point_fraction", o.planar_point_fraction, fraction());
-  visit("num_segments", o.num_segments, non_negative());
-  visit("noise_px", o.noise_px, non_negative());
-  visit("point_outlier_ratio", o.point_outlier_ratio, fraction());
-  visit("line_outlier_ratio", o.line_outlier_ratio, fraction());
-  visit("num_vps", o.num_vps, non_negative());
-  visit("lines_per_vp_fit", o.lines_per_vp_fit, non_negative());
-  visit("vp_noise_deg", o.vp_noise_deg, non_negative());
-  visit("orient_vps", o.orient_vps);
-  visit("focal_px", o.focal_px, positive());
-  visit("width", o.width, positive());
-  visit("height", o.height, positive());
-  visit("baseline", o.baseline, non_negative());
-  visit("max_rotation_deg", o.max_rotation_deg, non_negative());
-  visit("junction_fraction", o.junction_fraction, fraction());
-  visit("min_segment_px", o.min_segment_px, positive());
-  visit("max_segment_px", o.max_segment_px, positive());
+  HYBRID_VO_FIELDS(non_negative(), o.num_points, o.num_segments, o.noise_px, o.num_vps,
+                  o.lines_per_vp_fit, o.vp_noise_deg, o.baseline, o.max_rotation_deg);
+  HYBRID_VO_FIELDS(fraction(), o.planar_point_fraction, o.point_outlier_ratio, o.line_outlier_ratio,
+                  o.junction_fraction);
+  HYBRID_VO_FIELDS(any_value(), o.orient_vps);
+  HYBRID_VO_FIELDS(positive(), o.focal_px, o.width, o.height, o.min_segment_px, o.max_segment_px);
 }
 
 // An axis-aligned plane of the scene: normal . X = offset in camera-1 coordinates, with

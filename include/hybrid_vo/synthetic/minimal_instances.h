@@ -30,11 +30,9 @@ struct MinimalInstanceOptions {
 
 template <typename Visit>
 void visit_fields(MinimalInstanceOptions& o, Visit&& visit) {
-  visit("noise", o.noise, non_negative());
-  visit("lines_per_vp", o.lines_per_vp, positive());
-  visit("orient_vps", o.orient_vps);
-  visit("scene_spread", o.scene_spread, positive());
-  visit("extra_points", o.extra_points, non_negative());
+  HYBRID_VO_FIELDS(non_negative(), o.noise, o.extra_points);
+  HYBRID_VO_FIELDS(positive(), o.lines_per_vp, o.scene_spread);
+  HYBRID_VO_FIELDS(any_value(), o.orient_vps);
 }
 
 struct MinimalInstance {
