@@ -1,6 +1,8 @@
 // The node's ROS parameters: every one that config/default.yaml lists is read, each set to a value
 // other than its default changes what the node runs with, bad values and misspelt names are
 // reported and leave the default, and the options validate themselves (validate()).
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <functional>
 #include <regex>
@@ -8,8 +10,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "hybrid_vo/node/node_parameters.h"
 
@@ -53,7 +53,8 @@ struct Case {
 std::vector<Case> every_parameter() {
   using P = const NodeParameters&;
   return {
-      {"preset", "5pc", [](P p) { return !p.odometry.estimator.ransac.enabled[7] && p.preset == "5pc"; }},
+      {"preset", "5pc",
+       [](P p) { return !p.odometry.estimator.ransac.enabled[7] && p.preset == "5pc"; }},
       {"odom_frame", "world", [](P p) { return p.odom_frame == "world"; }},
       {"base_frame", "robot", [](P p) { return p.base_frame == "robot"; }},
       {"publish_tf", false, [](P p) { return !p.publish_tf; }},

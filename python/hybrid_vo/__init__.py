@@ -28,7 +28,6 @@ from ._core import (  # noqa: F401  (re-exported)
     pose_error_deg,
     presets,
     sampson_errors_px,
-    solve_minimal,
     solvers,
     synthetic,
     vp_detection_options,
@@ -85,6 +84,18 @@ def _solver_function(info):
 
 for _info in solvers():
     globals()[_info["function"]] = _solver_function(_info)
+
+
+def solve_minimal(solver, x1=None, x2=None, s1=None, s2=None, v1=None, v2=None,
+                  vp_signs_known=False):
+    """Runs the minimal solver `solver` (function name such as 'relpose_1vp_3pt', or paper code
+    such as '3-0-1' or '2-1-1p') through the C++ dispatcher that the hybrid RANSAC uses. Pass
+    exactly the inputs the solver takes (hybrid_vo.solvers() lists them): x1, x2 as num_points x 2,
+    s1, s2 as num_lines x 4, v1, v2 as num_vps x 3 (or a 3-vector for one VP); None is not given.
+    Returns a list of (R, t) like the solver's own function."""
+    arrays = {"x1": x1, "x2": x2, "s1": s1, "s2": s2, "v1": v1, "v2": v2}
+    return _core._solve(solver, "vp_signs_known", vp_signs_known,
+                        **{name: a for name, a in arrays.items() if a is not None})
 
 # The generators live in the extension as a submodule; make `import hybrid_vo.synthetic` work.
 _sys.modules[__name__ + ".synthetic"] = synthetic
@@ -182,8 +193,8 @@ def estimate_relative_pose(camera1, camera2, points1, points2, segments1=None, s
     the estimator cannot use gives a status instead.
     """
     return RelativePoseEstimate(_core._estimate_relative_pose(
-        camera1, camera2, points1, points2, segments1, segments2, vps, preset, line_vp=line_vp,
-        vp_signs_known=vp_signs_known, **options))
+        camera1, camera2, points1, points2, segments1, segments2, vps, preset, line_vp,
+        vp_signs_known, options))
 
 
 def detect_vanishing_points(*args, mode="joint", **options):
@@ -221,10 +232,10 @@ def detect_vanishing_points(*args, mode="joint", **options):
         if mode != "joint":
             raise ValueError("mode: only for two views (camera1, camera2, segments1, segments2)")
         return _core._detect_vanishing_points(given["camera"], given["segments"], None, None, mode,
-                                              **options)
+                                              options)
     if set(given) == set(names2):
         return _core._detect_vanishing_points(given["camera1"], given["segments1"],
-                                              given["camera2"], given["segments2"], mode, **options)
+                                              given["camera2"], given["segments2"], mode, options)
     raise TypeError(
         "detect_vanishing_points takes (camera, segments) or "
         f"(camera1, camera2, segments1, segments2); got {sorted(given)}")

@@ -29,9 +29,12 @@ bool read_value(const XmlRpcValue& v, int* out) {
 }
 bool read_value(const XmlRpcValue& v, double* out) {
   XmlRpcValue& value = const_cast<XmlRpcValue&>(v);
-  if (v.getType() == XmlRpcValue::TypeDouble) *out = static_cast<double>(value);
-  else if (v.getType() == XmlRpcValue::TypeInt) *out = static_cast<int>(value);
-  else return false;
+  if (v.getType() == XmlRpcValue::TypeDouble)
+    *out = static_cast<double>(value);
+  else if (v.getType() == XmlRpcValue::TypeInt)
+    *out = static_cast<int>(value);
+  else
+    return false;
   return true;
 }
 bool read_value(const XmlRpcValue& v, std::string* out) {
@@ -110,7 +113,8 @@ const std::vector<Parameter>& parameters() {
                VisualOdometryOptions& o = p->odometry;
                if (v != "klt") {
                  o.point_source = PointFeatureSource::kDescriptors;
-                 o.features.points.type = v == "orb" ? PointFeatureType::kOrb : PointFeatureType::kSift;
+                 o.features.points.type =
+                     v == "orb" ? PointFeatureType::kOrb : PointFeatureType::kSift;
                }
                p->points = v;
              }),
@@ -163,8 +167,7 @@ NodeParameters::NodeParameters() {
   odometry.estimator.vp_detection.min_inliers = 6;
 }
 
-NodeParameters read_node_parameters(const XmlRpcValue& params,
-                                    std::vector<std::string>* warnings) {
+NodeParameters read_node_parameters(const XmlRpcValue& params, std::vector<std::string>* warnings) {
   NodeParameters out;
   const bool have = params.getType() == XmlRpcValue::TypeStruct;
   std::set<std::string> known;

@@ -2,10 +2,8 @@
 
 #include <cmath>
 #include <limits>
-#include <set>
 
-namespace hybrid_vo {
-namespace python {
+namespace hybrid_vo::python {
 namespace {
 
 using namespace pybind11::literals;
@@ -23,7 +21,7 @@ std::string shape_text(const py::array& a) {
 }
 
 std::string expected_shape(py::ssize_t rows, py::ssize_t cols) {
-  const std::string r = rows == MatrixArgument::kAnyRows ? "N" : std::to_string(rows);
+  const std::string r = rows == kAnyRows ? "N" : std::to_string(rows);
   std::string text = "(" + r + ", " + std::to_string(cols) + ")";
   if (rows == 1) text += " or (" + std::to_string(cols) + ",)";
   return text;
@@ -51,15 +49,33 @@ py::array as_array(py::handle value, const std::string& name, const std::string&
   }
 }
 
+// The rows of a matrix argument, each read by `row`.
+template <typename T, typename Row>
+std::vector<T> rows_of(const RowMatrix& m, Row row) {
+  std::vector<T> out(m.rows());
+  for (Eigen::Index i = 0; i < m.rows(); ++i) out[i] = row(m.row(i));
+  return out;
+}
+
+Eigen::Vector4d segment_row(const LineSegment& s) {
+  return {s.p1.x(), s.p1.y(), s.p2.x(), s.p2.y()};
+}
+
 }  // namespace
 
 void throw_value_error(const std::string& argument, const std::string& message) {
   throw py::value_error(argument + ": " + message);
 }
 
-MatrixArgument::MatrixArgument(py::handle value, const std::string& name, py::ssize_t cols,
-                               py::ssize_t rows)
-    : cols_(cols) {
+void check_same_rows(size_t other_rows, const std::string& other, size_t rows,
+                     const std::string& name) {
+  if (rows != other_rows)
+    throw_value_error(
+        name, std::to_string(rows) + " rows, but " + other + " has " + std::to_string(other_rows));
+}
+
+RowMatrix matrix_argument(py::handle value, const std::string& name, py::ssize_t cols,
+                          py::ssize_t rows) {
   const std::string expected = "a float64 array of shape " + expected_shape(rows, cols);
   const bool converted = !py::isinstance<py::array>(value);
   py::array a = as_array(value, name, expected);
@@ -84,29 +100,41 @@ MatrixArgument::MatrixArgument(py::handle value, const std::string& name, py::ss
                       "not C-contiguous (a strided view or a transpose); pass "
                       "np.ascontiguousarray(" +
                           name + ")");
-  rows_ = vector_form ? 1 : a.shape(0);
-  data_ = static_cast<const double*>(a.data());
-  for (py::ssize_t i = 0; i < rows_ * cols_; ++i) {
-    if (!std::isfinite(data_[i])) {
-      const std::string where =
-          vector_form ? "[" + std::to_string(i) + "]"
-                      : "[" + std::to_string(i / cols_) + ", " + std::to_string(i % cols_) + "]";
-      throw_value_error(name, "value " + where + " is not finite (" +
-                                  std::string(py::str(py::float_(data_[i]))) + ")");
-    }
+  const RowMatrix m = Eigen::Map<const RowMatrix>(static_cast<const double*>(a.data()),
+                                                  vector_form ? 1 : a.shape(0), cols);
+  const bool finite = m.allFinite();
+  for (Eigen::Index k = 0; !finite && k < m.size(); ++k) {  // name the first value that is not
+    const Eigen::Index i = k / cols, j = k % cols;
+    if (std::isfinite(m(i, j))) continue;
+    const std::string where = vector_form
+                                  ? "[" + std::to_string(j) + "]"
+                                  : "[" + std::to_string(i) + ", " + std::to_string(j) + "]";
+    throw_value_error(name, "value " + where + " is not finite (" +
+                                std::string(py::str(py::float_(m(i, j)))) + ")");
   }
-  owner_ = std::move(a);
+  return m;
+}
+
+std::vector<Eigen::Vector2d> points_argument(py::handle value, const std::string& name,
+                                             py::ssize_t rows) {
+  return rows_of<Eigen::Vector2d>(matrix_argument(value, name, 2, rows),
+                                  [](const auto& r) { return r.transpose(); });
+}
+
+std::vector<LineSegment> segments_argument(py::handle value, const std::string& name,
+                                           py::ssize_t rows) {
+  return rows_of<LineSegment>(matrix_argument(value, name, 4, rows), [](const auto& r) {
+    return LineSegment{{r(0), r(1)}, {r(2), r(3)}};
+  });
 }
 
 std::vector<Eigen::Vector3d> directions_argument(py::handle value, const std::string& name,
                                                  py::ssize_t rows) {
-  const MatrixArgument m(value, name, 3, rows);
-  std::vector<Eigen::Vector3d> out;
-  for (py::ssize_t i = 0; i < m.rows(); ++i) {
-    out.push_back(m.vector3(i));
-    if (out.back().squaredNorm() == 0.0)
+  const std::vector<Eigen::Vector3d> out = rows_of<Eigen::Vector3d>(
+      matrix_argument(value, name, 3, rows), [](const auto& r) { return r.transpose(); });
+  for (size_t i = 0; i < out.size(); ++i)
+    if (out[i].squaredNorm() == 0.0)
       throw_value_error(name, "direction " + std::to_string(i) + " is zero");
-  }
   return out;
 }
 
@@ -117,34 +145,28 @@ bool bool_argument(py::handle value, const std::string& name) {
 }
 
 double number_argument(py::handle value, const std::string& name) {
-  double v = std::numeric_limits<double>::quiet_NaN();
-  const bool python_number =
-      !PyBool_Check(value.ptr()) && (PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()));
-  if (python_number || is_numpy_scalar_of(value, "integer") ||
-      is_numpy_scalar_of(value, "floating")) {
-    v = PyFloat_AsDouble(value.ptr());
-    if (PyErr_Occurred()) {
-      PyErr_Clear();
-      v = std::numeric_limits<double>::infinity();
-    }
-  } else {
-    throw_value_error(name, "expected a number, got " + std::string(py::repr(value)));
-  }
+  const bool number =
+      !PyBool_Check(value.ptr()) &&
+      (PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()) ||
+       is_numpy_scalar_of(value, "integer") || is_numpy_scalar_of(value, "floating"));
+  if (!number) throw_value_error(name, "expected a number, got " + std::string(py::repr(value)));
+  double v = PyFloat_AsDouble(value.ptr());
+  if (PyErr_Occurred()) PyErr_Clear(), v = std::numeric_limits<double>::infinity();  // a huge int
   if (!std::isfinite(v))
     throw_value_error(name, "expected a finite number, got " + std::string(py::repr(value)));
   return v;
 }
 
 long long integer_argument(py::handle value, const std::string& name) {
-  const bool python_int = PyLong_Check(value.ptr()) && !PyBool_Check(value.ptr());
-  if (!python_int && !is_numpy_scalar_of(value, "integer"))
-    throw_value_error(name, "expected an integer, got " + std::string(py::repr(value)));
-  int overflow = 0;
-  const py::object as_int = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  const bool integer = (PyLong_Check(value.ptr()) && !PyBool_Check(value.ptr())) ||
+                       is_numpy_scalar_of(value, "integer");
+  const py::object as_int =
+      integer ? py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr())) : py::object();
   if (!as_int) {
     PyErr_Clear();
     throw_value_error(name, "expected an integer, got " + std::string(py::repr(value)));
   }
+  int overflow = 0;
   const long long v = PyLong_AsLongLongAndOverflow(as_int.ptr(), &overflow);
   if (overflow != 0)
     throw_value_error(name, "integer out of range: " + std::string(py::repr(value)));
@@ -173,42 +195,51 @@ std::vector<int> labels_argument(py::handle value, const std::string& name) {
   return out;
 }
 
+std::string choice_argument(py::handle value, const std::string& name,
+                            const std::vector<std::string>& choices) {
+  const std::string s = py::isinstance<py::str>(value) ? py::cast<std::string>(value) : "";
+  if (std::find(choices.begin(), choices.end(), s) != choices.end()) return s;
+  std::string expected;
+  for (size_t k = 0; k < choices.size(); ++k)
+    expected += (k == 0 ? "'" : k + 1 < choices.size() ? ", '" : " or '") + choices[k] + "'";
+  throw_value_error(name, "expected " + expected + ", got " + std::string(py::repr(value)));
+}
+
 PinholeCamera camera_argument(py::handle value, const std::string& name,
                               std::array<double, 5>* distortion) {
   const std::string forms = distortion ? "a dict {fx, fy, cx, cy[, width, height, distortion]} "
                                          "or a sequence fx, fy, cx, cy[, k1, k2, p1, p2, k3]"
                                        : "a dict {fx, fy, cx, cy[, width, height]} or a "
                                          "sequence fx, fy, cx, cy";
+  std::array<double, 9> v{};  // fx, fy, cx, cy, then the distortion k1, k2, p1, p2, k3
   PinholeCamera camera;
-  std::array<double, 5> coefficients{};
   if (py::isinstance<py::dict>(value)) {
     const py::dict d = py::reinterpret_borrow<py::dict>(value);
-    std::set<std::string> allowed = {"fx", "fy", "cx", "cy", "width", "height"};
-    if (distortion) allowed.insert("distortion");
+    const std::vector<std::string> keys = {"fx", "fy", "cx", "cy", "width", "height", "distortion"};
+    const auto allowed = keys.end() - (distortion ? 0 : 1);
     for (const auto& item : d) {
       const std::string key = py::str(item.first);
-      if (!allowed.count(key))
+      if (std::find(keys.begin(), allowed, key) == allowed)
         throw_value_error(
             name, "unknown key '" + key + "' (expected " + forms + ")" +
                       (key == "distortion" ? "; the estimator takes undistorted pixels" : ""));
     }
-    double* fields[] = {&camera.fx, &camera.fy, &camera.cx, &camera.cy};
-    const char* keys[] = {"fx", "fy", "cx", "cy"};
-    for (int k = 0; k < 4; ++k) {
-      if (!d.contains(keys[k]))
-        throw_value_error(name, std::string("missing key '") + keys[k] + "'");
-      *fields[k] = number_argument(d[keys[k]], name + "['" + keys[k] + "']");
-    }
-    for (const char* key : {"width", "height"}) {
-      if (!d.contains(key)) continue;
-      const long long size = integer_argument(d[key], name + "['" + key + "']");
-      if (size < 0 || size > std::numeric_limits<int>::max())
-        throw_value_error(name + "['" + key + "']", "expected a size >= 0");
-      (std::string(key) == "width" ? camera.width : camera.height) = static_cast<int>(size);
+    for (int k = 0; k < 6; ++k) {
+      const std::string where = name + "['" + keys[k] + "']";
+      if (!d.contains(keys[k])) {
+        if (k < 4) throw_value_error(name, "missing key '" + keys[k] + "'");
+      } else if (k < 4) {
+        v[k] = number_argument(d[keys[k].c_str()], where);
+      } else {
+        const long long size = integer_argument(d[keys[k].c_str()], where);
+        if (size < 0 || size > std::numeric_limits<int>::max())
+          throw_value_error(where, "expected a size >= 0");
+        (k == 4 ? camera.width : camera.height) = static_cast<int>(size);
+      }
     }
     if (distortion && d.contains("distortion")) {
-      const MatrixArgument k(d["distortion"], name + "['distortion']", 5, 1);
-      for (int i = 0; i < 5; ++i) coefficients[i] = k(0, i);
+      const RowMatrix k = matrix_argument(d["distortion"], name + "['distortion']", 5, 1);
+      std::copy(k.data(), k.data() + 5, v.begin() + 4);
     }
   } else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value) ||
              (py::isinstance<py::array>(value) &&
@@ -217,40 +248,21 @@ PinholeCamera camera_argument(py::handle value, const std::string& name,
     const size_t n = py::len(seq);
     if (n != 4 && !(distortion && n == 9))
       throw_value_error(name, std::to_string(n) + " values, expected " + forms);
-    double* fields[] = {&camera.fx, &camera.fy, &camera.cx, &camera.cy};
-    for (size_t k = 0; k < n; ++k) {
-      const double v = number_argument(seq[k], name + "[" + std::to_string(k) + "]");
-      if (k < 4)
-        *fields[k] = v;
-      else
-        coefficients[k - 4] = v;
-    }
+    for (size_t k = 0; k < n; ++k)
+      v[k] = number_argument(seq[k], name + "[" + std::to_string(k) + "]");
   } else {
     throw_value_error(name, "expected " + forms + ", got " + type_name(value));
   }
+  camera.fx = v[0], camera.fy = v[1], camera.cx = v[2], camera.cy = v[3];
   if (!(camera.fx > 0.0) || !(camera.fy > 0.0))
     throw_value_error(name, "focal lengths must be positive");
-  if (distortion) *distortion = coefficients;
+  if (distortion) std::copy(v.begin() + 4, v.end(), distortion->begin());
   return camera;
 }
 
 py::dict camera_to_dict(const PinholeCamera& camera) {
   return py::dict("fx"_a = camera.fx, "fy"_a = camera.fy, "cx"_a = camera.cx, "cy"_a = camera.cy,
                   "width"_a = camera.width, "height"_a = camera.height);
-}
-
-py::array_t<bool> to_bool_array(const std::vector<char>& mask) {
-  py::array_t<bool> a(static_cast<py::ssize_t>(mask.size()));
-  bool* out = a.mutable_data();
-  for (size_t i = 0; i < mask.size(); ++i) out[i] = mask[i] != 0;
-  return a;
-}
-
-py::array_t<bool> to_bool_array(const std::vector<bool>& mask) {
-  py::array_t<bool> a(static_cast<py::ssize_t>(mask.size()));
-  bool* out = a.mutable_data();
-  for (size_t i = 0; i < mask.size(); ++i) out[i] = mask[i];
-  return a;
 }
 
 py::array_t<int64_t> to_int_array(const std::vector<int>& values) {
@@ -264,9 +276,7 @@ py::array_t<double> points_to_array(const std::vector<Eigen::Vector2d>& points) 
 }
 
 py::array_t<double> segments_to_array(const std::vector<LineSegment>& segments) {
-  return rows_to_array<double, 4>(segments, [](const LineSegment& s) {
-    return Eigen::Vector4d(s.p1.x(), s.p1.y(), s.p2.x(), s.p2.y());
-  });
+  return rows_to_array<double, 4>(segments, segment_row);
 }
 
 py::array_t<double> directions_to_array(const std::vector<Eigen::Vector3d>& directions) {
@@ -277,5 +287,27 @@ py::tuple pose_to_tuple(const RelativePose& pose) {
   return py::make_tuple(to_array(pose.R), to_array(pose.t));
 }
 
-}  // namespace python
-}  // namespace hybrid_vo
+py::dict matches_to_dict(const TwoViewMatches& matches) {
+  auto points = [&](Eigen::Vector2d PointMatch::*x) {
+    return rows_to_array<double, 2>(matches.points, [x](const PointMatch& m) { return m.*x; });
+  };
+  auto segments = [&](LineSegment LineMatch::*s) {
+    return rows_to_array<double, 4>(matches.lines,
+                                    [s](const LineMatch& m) { return segment_row(m.*s); });
+  };
+  return py::dict("points1"_a = points(&PointMatch::x1), "points2"_a = points(&PointMatch::x2),
+                  "segments1"_a = segments(&LineMatch::s1),
+                  "segments2"_a = segments(&LineMatch::s2));
+}
+
+py::dict vps_to_dict(const std::vector<VpMatch>& vps) {
+  auto directions = [&](Eigen::Vector3d VpMatch::*d) {
+    return rows_to_array<double, 3>(vps, [d](const VpMatch& vp) { return vp.*d; });
+  };
+  std::vector<char> known;
+  for (const VpMatch& vp : vps) known.push_back(vp.sign_known);
+  return py::dict("vps"_a = py::make_tuple(directions(&VpMatch::d1), directions(&VpMatch::d2)),
+                  "vp_signs_known"_a = to_bool_array(known));
+}
+
+}  // namespace hybrid_vo::python

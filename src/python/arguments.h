@@ -1,8 +1,8 @@
 #pragma once
 
-// Checked conversions of Python arguments for the bindings. Every failure raises ValueError
-// naming the argument: the bindings never read an array with the wrong shape, dtype or strides
-// and never pass NaN on to the core.
+// Checked conversions of Python arguments for the bindings, and of results back. Every failure
+// raises ValueError naming the argument: the bindings never read an array with the wrong shape,
+// dtype or strides and never pass NaN on to the core.
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -14,47 +14,36 @@
 #include <string>
 #include <vector>
 
+#include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/geometry/camera.h"
-#include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/pose.h"
 
-namespace hybrid_vo {
-namespace python {
+namespace hybrid_vo::python {
 
 namespace py = pybind11;
 
 [[noreturn]] void throw_value_error(const std::string& argument, const std::string& message);
+// "name: 39 rows, but other has 40" unless the row counts agree.
+void check_same_rows(size_t other_rows, const std::string& other, size_t rows,
+                     const std::string& name);
 
-// A validated rows x cols float64 array argument, read in place (the owner keeps it alive).
-// NumPy arrays must already be float64 and C-contiguous: the bindings refuse rather than copy a
-// strided view or round a float32 behind the caller's back. Lists and tuples of numbers are
-// converted (they have no layout to get wrong). With `rows` = 1 a 1-D array of `cols` values is
-// accepted too. Every value must be finite.
-class MatrixArgument {
- public:
-  static constexpr py::ssize_t kAnyRows = -1;
-  MatrixArgument(py::handle value, const std::string& name, py::ssize_t cols,
-                 py::ssize_t rows = kAnyRows);
+// A validated rows x cols float64 array argument, copied. NumPy arrays must already be float64
+// and C-contiguous: the bindings refuse rather than copy a strided view or round a float32 behind
+// the caller's back. Lists and tuples of numbers are converted (they have no layout to get wrong).
+// With `rows` = 1 a 1-D array of `cols` values is accepted too. Every value must be finite.
+constexpr py::ssize_t kAnyRows = -1;
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+RowMatrix matrix_argument(py::handle value, const std::string& name, py::ssize_t cols,
+                          py::ssize_t rows = kAnyRows);
 
-  py::ssize_t rows() const { return rows_; }
-  double operator()(py::ssize_t i, py::ssize_t j) const { return data_[i * cols_ + j]; }
-  Eigen::Vector2d point(py::ssize_t i) const { return {(*this)(i, 0), (*this)(i, 1)}; }
-  Eigen::Vector3d vector3(py::ssize_t i) const {
-    return {(*this)(i, 0), (*this)(i, 1), (*this)(i, 2)};
-  }
-  LineSegment segment(py::ssize_t i) const {
-    return {{(*this)(i, 0), (*this)(i, 1)}, {(*this)(i, 2), (*this)(i, 3)}};
-  }
-
- private:
-  py::object owner_;
-  const double* data_ = nullptr;
-  py::ssize_t rows_ = 0, cols_ = 0;
-};
-
-// N x 3 directions (a 3-vector for N = 1), none of them zero.
+// N x 2 points, N x 4 segments (x1, y1, x2, y2) and N x 3 directions, none of them zero (a
+// 1-D array for N = 1).
+std::vector<Eigen::Vector2d> points_argument(py::handle value, const std::string& name,
+                                             py::ssize_t rows = kAnyRows);
+std::vector<LineSegment> segments_argument(py::handle value, const std::string& name,
+                                           py::ssize_t rows = kAnyRows);
 std::vector<Eigen::Vector3d> directions_argument(py::handle value, const std::string& name,
-                                                 py::ssize_t rows);
+                                                 py::ssize_t rows = kAnyRows);
 
 // True or False (Python or NumPy bools; numbers are refused, so that 0.5 is not read as True).
 bool bool_argument(py::handle value, const std::string& name);
@@ -66,11 +55,14 @@ std::vector<int> labels_argument(py::handle value, const std::string& name);
 double number_argument(py::handle value, const std::string& name);
 long long integer_argument(py::handle value, const std::string& name);
 
-// A pinhole camera: a dict with fx, fy, cx, cy (and optionally width, height), a PoseLib/COLMAP
-// style dict {"model": "PINHOLE" | "SIMPLE_PINHOLE", "params": [...], "width", "height"}, or a
-// sequence fx, fy, cx, cy. With `distortion` non-null, OpenCV's plumb-bob coefficients are
-// accepted too (dict key "distortion", a COLMAP "OPENCV" model, or a 9-sequence); without it a
-// distorted camera is refused, since the core takes undistorted pixels.
+// One of `choices`, a string.
+std::string choice_argument(py::handle value, const std::string& name,
+                            const std::vector<std::string>& choices);
+
+// A pinhole camera: a dict with fx, fy, cx, cy (and optionally width, height) or a sequence fx,
+// fy, cx, cy. With `distortion` non-null, OpenCV's plumb-bob coefficients are accepted too (dict
+// key "distortion", or a 9-sequence); without it a distorted camera is refused, since the core
+// takes undistorted pixels.
 PinholeCamera camera_argument(py::handle value, const std::string& name,
                               std::array<double, 5>* distortion = nullptr);
 // The inverse for results: {"fx", "fy", "cx", "cy", "width", "height"}.
@@ -92,8 +84,13 @@ py::array_t<double> to_array(const Eigen::MatrixBase<Derived>& m) {
     return a;
   }
 }
-py::array_t<bool> to_bool_array(const std::vector<char>& mask);
-py::array_t<bool> to_bool_array(const std::vector<bool>& mask);
+// A mask (std::vector<char> or <bool>) as a bool array.
+template <typename Mask>
+py::array_t<bool> to_bool_array(const Mask& mask) {
+  py::array_t<bool> a(static_cast<py::ssize_t>(mask.size()));
+  for (size_t i = 0; i < mask.size(); ++i) a.mutable_data()[i] = mask[i] != 0;
+  return a;
+}
 py::array_t<int64_t> to_int_array(const std::vector<int>& values);
 // An N x cols array whose row i is row(items[i]), an Eigen vector of `cols` values.
 template <typename Scalar, int Cols, typename T, typename Row>
@@ -111,6 +108,11 @@ py::array_t<double> segments_to_array(const std::vector<LineSegment>& segments);
 py::array_t<double> directions_to_array(const std::vector<Eigen::Vector3d>& directions);
 // A pose as the tuple (R, t).
 py::tuple pose_to_tuple(const RelativePose& pose);
+// Point and segment matches as estimate_relative_pose takes them: points1, points2 (N x 2),
+// segments1, segments2 (M x 4).
+py::dict matches_to_dict(const TwoViewMatches& matches);
+// VP matches as estimate_relative_pose takes them: vps (K x 3 directions in each view) and
+// vp_signs_known.
+py::dict vps_to_dict(const std::vector<VpMatch>& vps);
 
-}  // namespace python
-}  // namespace hybrid_vo
+}  // namespace hybrid_vo::python

@@ -4,77 +4,72 @@
 #include "hybrid_vo/lines/two_view.h"
 #include "options.h"
 
-namespace hybrid_vo {
-namespace python {
+namespace hybrid_vo::python {
 namespace {
 
 using namespace pybind11::literals;
 
-void read_match_pair(py::handle a, py::handle b, const char* name_a, const char* name_b, int cols,
-                     std::vector<MatrixArgument>* out) {
+// Both of a pair of arguments, or neither (None).
+bool both_or_neither(py::handle a, py::handle b, const char* name_a, const char* name_b) {
   if (a.is_none() != b.is_none())
     throw_value_error(a.is_none() ? name_a : name_b, std::string("None while ") +
                                                          (a.is_none() ? name_b : name_a) +
                                                          " is given (pass both or neither)");
-  if (a.is_none()) return;
-  out->emplace_back(a, name_a, cols);
-  out->emplace_back(b, name_b, cols);
-  if ((*out)[0].rows() != (*out)[1].rows())
-    throw_value_error(name_b, std::to_string((*out)[1].rows()) + " rows, but " + name_a + " has " +
-                                  std::to_string((*out)[0].rows()));
+  return !a.is_none();
+}
+
+// Per VP match whether d2 = +R d1 is known: one bool for all, or one each.
+void read_vp_signs_known(py::handle value, std::vector<VpMatch>* vps) {
+  if (PyBool_Check(value.ptr()) ||
+      py::isinstance(value, py::module_::import("numpy").attr("bool_"))) {
+    for (VpMatch& vp : *vps) vp.sign_known = bool_argument(value, "vp_signs_known");
+    return;
+  }
+  const bool array = py::isinstance<py::array>(value);
+  if (!(array && py::reinterpret_borrow<py::array>(value).ndim() == 1) &&
+      !py::isinstance<py::list>(value) && !py::isinstance<py::tuple>(value))
+    throw_value_error("vp_signs_known", "expected a bool or one bool per VP");
+  const py::sequence seq = py::reinterpret_borrow<py::sequence>(value);
+  if (py::len(seq) != vps->size())
+    throw_value_error("vp_signs_known", std::to_string(py::len(seq)) + " values for " +
+                                            std::to_string(vps->size()) + " VPs");
+  for (size_t k = 0; k < vps->size(); ++k)
+    (*vps)[k].sign_known = bool_argument(seq[k], "vp_signs_known[" + std::to_string(k) + "]");
 }
 
 TwoViewMatches read_matches(py::handle points1, py::handle points2, py::handle segments1,
                             py::handle segments2, py::handle vps, py::handle line_vp,
                             py::handle vp_signs_known) {
   TwoViewMatches matches;
-  std::vector<MatrixArgument> points, segments;
-  read_match_pair(points1, points2, "points1", "points2", 2, &points);
-  read_match_pair(segments1, segments2, "segments1", "segments2", 4, &segments);
-  if (!points.empty()) {
-    matches.points.resize(points[0].rows());
-    for (py::ssize_t i = 0; i < points[0].rows(); ++i)
-      matches.points[i] = {points[0].point(i), points[1].point(i)};
+  if (both_or_neither(points1, points2, "points1", "points2")) {
+    const auto p1 = points_argument(points1, "points1"), p2 = points_argument(points2, "points2");
+    check_same_rows(p1.size(), "points1", p2.size(), "points2");
+    matches.points.resize(p1.size());
+    for (size_t i = 0; i < p1.size(); ++i) matches.points[i] = {p1[i], p2[i]};
   }
-  if (!segments.empty()) {
-    matches.lines.resize(segments[0].rows());
-    for (py::ssize_t i = 0; i < segments[0].rows(); ++i)
-      matches.lines[i] = {segments[0].segment(i), segments[1].segment(i)};
+  const bool segments = both_or_neither(segments1, segments2, "segments1", "segments2");
+  if (segments) {
+    const auto s1 = segments_argument(segments1, "segments1");
+    const auto s2 = segments_argument(segments2, "segments2");
+    check_same_rows(s1.size(), "segments1", s2.size(), "segments2");
+    matches.lines.resize(s1.size());
+    for (size_t i = 0; i < s1.size(); ++i) matches.lines[i] = {s1[i], s2[i]};
   }
   if (!vps.is_none()) {
     if (!(py::isinstance<py::tuple>(vps) || py::isinstance<py::list>(vps)) || py::len(vps) != 2)
       throw_value_error("vps", "expected a pair (directions1, directions2) of K x 3 arrays");
     const py::sequence pair = py::reinterpret_borrow<py::sequence>(vps);
-    const auto d1 = directions_argument(pair[0], "vps[0]", MatrixArgument::kAnyRows);
-    const auto d2 = directions_argument(pair[1], "vps[1]", MatrixArgument::kAnyRows);
-    if (d1.size() != d2.size())
-      throw_value_error("vps[1]", std::to_string(d2.size()) + " rows, but vps[0] has " +
-                                      std::to_string(d1.size()));
-    matches.vps.resize(d1.size());
-    for (size_t k = 0; k < d1.size(); ++k) matches.vps[k] = {d1[k], d2[k], false};
+    const auto d1 = directions_argument(pair[0], "vps[0]");
+    const auto d2 = directions_argument(pair[1], "vps[1]");
+    check_same_rows(d1.size(), "vps[0]", d2.size(), "vps[1]");
+    for (size_t k = 0; k < d1.size(); ++k) matches.vps.push_back({d1[k], d2[k], false});
   }
   if (!vp_signs_known.is_none()) {
     if (vps.is_none()) throw_value_error("vp_signs_known", "given without vps");
-    if (PyBool_Check(vp_signs_known.ptr()) ||
-        py::isinstance(vp_signs_known, py::module_::import("numpy").attr("bool_"))) {
-      const bool known = bool_argument(vp_signs_known, "vp_signs_known");
-      for (VpMatch& vp : matches.vps) vp.sign_known = known;
-    } else {
-      const bool array = py::isinstance<py::array>(vp_signs_known);
-      if (!(array && py::reinterpret_borrow<py::array>(vp_signs_known).ndim() == 1) &&
-          !py::isinstance<py::list>(vp_signs_known) && !py::isinstance<py::tuple>(vp_signs_known))
-        throw_value_error("vp_signs_known", "expected a bool or one bool per VP");
-      const py::sequence seq = py::reinterpret_borrow<py::sequence>(vp_signs_known);
-      if (py::len(seq) != matches.vps.size())
-        throw_value_error("vp_signs_known", std::to_string(py::len(seq)) + " values for " +
-                                                std::to_string(matches.vps.size()) + " VPs");
-      for (size_t k = 0; k < matches.vps.size(); ++k)
-        matches.vps[k].sign_known =
-            bool_argument(seq[k], "vp_signs_known[" + std::to_string(k) + "]");
-    }
+    read_vp_signs_known(vp_signs_known, &matches.vps);
   }
   if (!line_vp.is_none()) {
-    if (vps.is_none() || segments.empty())
+    if (vps.is_none() || !segments)
       throw_value_error("line_vp", "labels segments with VPs: needs segments1/2 and vps");
     matches.line_vp = labels_argument(line_vp, "line_vp");
     if (matches.line_vp.size() != matches.lines.size())
@@ -107,7 +102,7 @@ py::array_t<int64_t> derived_sources(const std::vector<DerivedPoint>& derived) {
 // The estimate as the fields of hybrid_vo.RelativePoseEstimate (python/hybrid_vo/__init__.py).
 py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py::handle points2,
                   py::handle segments1, py::handle segments2, py::handle vps, py::handle preset,
-                  py::handle line_vp, py::handle vp_signs_known, const py::kwargs& options) {
+                  py::handle line_vp, py::handle vp_signs_known, const py::dict& options) {
   const PinholeCamera c1 = camera_argument(camera1, "camera1");
   const PinholeCamera c2 = camera_argument(camera2, "camera2");
   TwoViewOptions two_view_options = preset_two_view_options(preset);
@@ -121,10 +116,6 @@ py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py
   }
   const RelativePoseEstimate& e = two_view.estimate;
   const bool ok = e.status == EstimationStatus::kOk;
-  const std::vector<VpMatch>& used = two_view.vps_detected ? two_view.vps.matches : matches.vps;
-  std::vector<Eigen::Vector3d> d1, d2;
-  std::vector<char> known;
-  for (const VpMatch& vp : used) d1.push_back(vp.d1), d2.push_back(vp.d2), known.push_back(vp.sign_known);
   py::dict solvers;
   for (const SolverInfo& info : solver_table()) {
     const SolverStatistics& s = e.solvers[static_cast<int>(info.id)];
@@ -132,7 +123,7 @@ py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py
                                       "models"_a = s.models, "best"_a = s.best);
   }
   const py::object none = py::none();
-  return py::dict(
+  py::dict fields(
       "status"_a = to_string(e.status), "ok"_a = ok,
       "R"_a = ok ? py::object(to_array(e.pose.R)) : none,
       "t"_a = ok ? py::object(to_array(e.pose.t)) : none,
@@ -149,8 +140,6 @@ py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py
       "junction_segments"_a = derived_sources(e.junctions),
       "endpoints"_a = derived_points(e.endpoints),
       "endpoint_segments"_a = derived_sources(e.endpoints),
-      "vps"_a = py::make_tuple(directions_to_array(d1), directions_to_array(d2)),
-      "vp_signs_known"_a = to_bool_array(known),
       "line_vp"_a = to_int_array(two_view.vps_detected ? two_view.vps.labels : matches.line_vp),
       "vps_detected"_a = two_view.vps_detected, "solver_statistics"_a = solvers,
       "best_solver"_a = ok ? py::object(py::str(solver_info(e.best_solver).function)) : none,
@@ -158,38 +147,24 @@ py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py
       "refined"_a = e.refined,
       "rejected"_a = py::dict("points"_a = e.rejected_points, "lines"_a = e.rejected_lines,
                               "vps"_a = e.rejected_vps),
-      "timings"_a = py::dict("vp_detection_ms"_a = two_view.vp_ms, "derive_ms"_a = e.derive_ms,
-                             "ransac_ms"_a = e.ransac_ms, "refine_ms"_a = e.refine_ms,
-                             "estimator_ms"_a = e.total_ms,
-                             "total_ms"_a = two_view.vp_ms + e.total_ms));
+      "timings"_a =
+          py::dict("vp_detection_ms"_a = two_view.vp_ms, "derive_ms"_a = e.derive_ms,
+                   "ransac_ms"_a = e.ransac_ms, "refine_ms"_a = e.refine_ms,
+                   "estimator_ms"_a = e.total_ms, "total_ms"_a = two_view.vp_ms + e.total_ms));
+  // The VP matches used: detected, or the given ones.
+  fields.attr("update")(vps_to_dict(two_view.vps_detected ? two_view.vps.matches : matches.vps));
+  return fields;
 }
 
 }  // namespace
 
-SolverId solver_argument(py::handle value, const std::string& name) {
-  SolverId id;
-  if (!py::isinstance<py::str>(value) || !find_solver(py::cast<std::string>(value), &id))
-    throw_value_error(name, "unknown solver " + std::string(py::repr(value)) +
-                                " (function names or paper codes, hybrid_vo.solvers())");
-  return id;
-}
-
 void bind_estimator(py::module_& m) {
-  m.def(
-      "_estimate_relative_pose", &estimate, "camera1"_a, "camera2"_a, "points1"_a, "points2"_a,
-      "segments1"_a = py::none(), "segments2"_a = py::none(), "vps"_a = py::none(),
-      "preset"_a = "hybrid+junc", py::kw_only(), "line_vp"_a = py::none(),
-      "vp_signs_known"_a = py::none(),
-      "_estimate_relative_pose(camera1, camera2, points1, points2, segments1=None, "
-      "segments2=None, vps=None, preset='hybrid+junc', *, line_vp=None, vp_signs_known=None, "
-      "**options)\n--\n\nThe fields of a RelativePoseEstimate; see "
-      "hybrid_vo.estimate_relative_pose.");
+  // hybrid_vo.estimate_relative_pose passes every argument, and its keyword options as a dict.
+  m.def("_estimate_relative_pose", &estimate, "The fields of a RelativePoseEstimate.");
 
   m.def(
       "estimator_options",
-      [](py::handle preset) {
-        return options_dict(preset_two_view_options(preset));
-      },
+      [](py::handle preset) { return options_dict(preset_two_view_options(preset)); },
       "preset"_a = "hybrid+junc",
       "estimator_options(preset='hybrid+junc')\n--\n\n"
       "Every keyword option of estimate_relative_pose with its value under `preset`, as a dict. "
@@ -204,5 +179,4 @@ void bind_estimator(py::module_& m) {
       "presets()\n--\n\nThe estimator presets (the paper's table rows).");
 }
 
-}  // namespace python
-}  // namespace hybrid_vo
+}  // namespace hybrid_vo::python

@@ -7,8 +7,7 @@
 #include "hybrid_vo/synthetic/minimal_instances.h"
 #include "options.h"
 
-namespace hybrid_vo {
-namespace python {
+namespace hybrid_vo::python {
 namespace {
 
 using namespace pybind11::literals;
@@ -23,43 +22,25 @@ uint64_t seed_argument(py::handle value) {
 py::dict solver_inputs(const SolverInfo& info, const MinimalSample& s) {
   py::dict inputs;
   const int np = info.num_points, nl = info.num_lines, nv = info.num_vps;
-  if (np > 0) {
-    inputs["x1"] = points_to_array({s.x1.begin(), s.x1.begin() + np});
-    inputs["x2"] = points_to_array({s.x2.begin(), s.x2.begin() + np});
+  for (const auto& [name, points] : {std::pair{"x1", &s.x1}, std::pair{"x2", &s.x2}})
+    if (np > 0) inputs[name] = points_to_array({points->begin(), points->begin() + np});
+  for (const auto& [name, lines] : {std::pair{"s1", &s.s1}, std::pair{"s2", &s.s2}})
+    if (nl > 0) inputs[name] = segments_to_array({lines->begin(), lines->begin() + nl});
+  for (const auto& [name, vps] : {std::pair{"v1", &s.v1}, std::pair{"v2", &s.v2}}) {
+    if (nv == 1) inputs[name] = to_array((*vps)[0]);
+    if (nv == 2) inputs[name] = directions_to_array({(*vps)[0], (*vps)[1]});
   }
-  if (nl > 0) {
-    inputs["s1"] = segments_to_array({s.s1.begin(), s.s1.begin() + nl});
-    inputs["s2"] = segments_to_array({s.s2.begin(), s.s2.begin() + nl});
-  }
-  if (nv == 1) {
-    inputs["v1"] = to_array(s.v1[0]);
-    inputs["v2"] = to_array(s.v2[0]);
-    inputs["vp_sign_known"] = s.vp_signs_known;
-  } else if (nv == 2) {
-    inputs["v1"] = directions_to_array({s.v1[0], s.v1[1]});
-    inputs["v2"] = directions_to_array({s.v2[0], s.v2[1]});
-    inputs["vp_signs_known"] = s.vp_signs_known;
-  }
+  if (nv > 0) inputs[nv == 1 ? "vp_sign_known" : "vp_signs_known"] = s.vp_signs_known;
   return inputs;
 }
 
 py::dict scene_to_dict(const ManhattanScene& scene) {
   const TwoViewMatches& m = scene.matches;
-  std::vector<Eigen::Vector2d> p1, p2;
-  std::vector<LineSegment> s1, s2;
-  std::vector<Eigen::Vector3d> d1, d2;
-  std::vector<char> known;
-  for (const PointMatch& p : m.points) p1.push_back(p.x1), p2.push_back(p.x2);
-  for (const LineMatch& l : m.lines) s1.push_back(l.s1), s2.push_back(l.s2);
-  for (const VpMatch& vp : m.vps)
-    d1.push_back(vp.d1), d2.push_back(vp.d2), known.push_back(vp.sign_known);
   py::dict inputs("camera1"_a = camera_to_dict(scene.camera1),
-                  "camera2"_a = camera_to_dict(scene.camera2), "points1"_a = points_to_array(p1),
-                  "points2"_a = points_to_array(p2), "segments1"_a = segments_to_array(s1),
-                  "segments2"_a = segments_to_array(s2));
+                  "camera2"_a = camera_to_dict(scene.camera2));
+  inputs.attr("update")(matches_to_dict(m));
   if (!m.vps.empty()) {
-    inputs["vps"] = py::make_tuple(directions_to_array(d1), directions_to_array(d2));
-    inputs["vp_signs_known"] = to_bool_array(known);
+    inputs.attr("update")(vps_to_dict(m.vps));
     if (!m.line_vp.empty()) inputs["line_vp"] = to_int_array(m.line_vp);
   }
   return py::dict("inputs"_a = inputs, "R"_a = to_array(scene.truth.R),
@@ -132,5 +113,4 @@ void bind_synthetic(py::module_& parent) {
       "scene_options()\n--\n\nThe options of manhattan_scenes with their defaults.");
 }
 
-}  // namespace python
-}  // namespace hybrid_vo
+}  // namespace hybrid_vo::python

@@ -9,8 +9,7 @@
 #include "arguments.h"
 #include "hybrid_vo/frontend/frontend.h"
 
-namespace hybrid_vo {
-namespace python {
+namespace hybrid_vo::python {
 namespace {
 
 using namespace pybind11::literals;
@@ -54,22 +53,12 @@ py::dict match_image_pair(py::handle image1, py::handle image2, py::handle camer
   const CameraModel c1 = camera_model_argument(camera, "camera", im1);
   const CameraModel c2 = camera2.is_none() ? c1 : camera_model_argument(camera2, "camera2", im2);
   FrontendOptions options;
-  const std::string p = py::isinstance<py::str>(points) ? py::cast<std::string>(points) : "";
-  const std::string l = py::isinstance<py::str>(lines) ? py::cast<std::string>(lines) : "";
-  if (p == "orb")
-    options.points.type = PointFeatureType::kOrb;
-  else if (p == "none")
-    options.use_points = false;
-  else if (p != "sift")
-    throw_value_error("points",
-                      "expected 'sift', 'orb' or 'none', got " + std::string(py::repr(points)));
-  if (l == "fld")
-    options.lines.detection.detector = LineDetector::kFld;
-  else if (l == "none")
-    options.use_lines = false;
-  else if (l != "lsd")
-    throw_value_error("lines",
-                      "expected 'lsd', 'fld' or 'none', got " + std::string(py::repr(lines)));
+  const std::string p = choice_argument(points, "points", {"sift", "orb", "none"});
+  const std::string l = choice_argument(lines, "lines", {"lsd", "fld", "none"});
+  options.use_points = p != "none";
+  if (p == "orb") options.points.type = PointFeatureType::kOrb;
+  options.use_lines = l != "none";
+  if (l == "fld") options.lines.detection.detector = LineDetector::kFld;
   const long long n = integer_argument(max_features, "max_features");
   if (n <= 0 || n > 1000000) throw_value_error("max_features", "expected 1 .. 1000000");
   options.points.max_features = static_cast<int>(n);
@@ -80,19 +69,13 @@ py::dict match_image_pair(py::handle image1, py::handle image2, py::handle camer
     const ImageFeatures f2 = extract_features(im2, options);
     matches = match_features(f1, f2, c1, c2, options);
   }
-  std::vector<Eigen::Vector2d> p1, p2;
-  std::vector<LineSegment> s1, s2;
-  for (const PointMatch& m : matches.points) p1.push_back(m.x1), p2.push_back(m.x2);
-  for (const LineMatch& m : matches.lines) s1.push_back(m.s1), s2.push_back(m.s2);
-  return py::dict("camera1"_a = camera_to_dict(c1.pinhole),
-                  "camera2"_a = camera_to_dict(c2.pinhole), "points1"_a = points_to_array(p1),
-                  "points2"_a = points_to_array(p2), "segments1"_a = segments_to_array(s1),
-                  "segments2"_a = segments_to_array(s2));
+  py::dict out("camera1"_a = camera_to_dict(c1.pinhole), "camera2"_a = camera_to_dict(c2.pinhole));
+  out.attr("update")(matches_to_dict(matches));
+  return out;
 }
 
 }  // namespace
-}  // namespace python
-}  // namespace hybrid_vo
+}  // namespace hybrid_vo::python
 
 PYBIND11_MODULE(frontend, m) {
   using namespace pybind11::literals;

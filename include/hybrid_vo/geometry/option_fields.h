@@ -27,7 +27,13 @@ namespace hybrid_vo {
 
 // In a visit_fields(o, visit) body: the fields o.a, o.b, ... under their own names ("a", "b"),
 // all within `bounds`.
-#define HYBRID_VO_FIELDS(bounds, ...) visit_named(visit, bounds, #__VA_ARGS__, __VA_ARGS__)
+// The names are split once per declaration (a static at the call site), not on every visit.
+#define HYBRID_VO_FIELDS(bounds, ...)                                  \
+  do {                                                                 \
+    static const std::vector<std::string> field_names =                \
+        ::hybrid_vo::spelled_field_names(#__VA_ARGS__);                \
+    ::hybrid_vo::visit_named(visit, bounds, field_names, __VA_ARGS__); \
+  } while (false)
 
 // The values a numeric option may take: [min, max], either end open.
 struct Bounds {
@@ -64,14 +70,19 @@ inline Bounds fraction() { return {0.0, 1.0}; }
 inline Bounds open_fraction() { return {0.0, 1.0, true, true}; }
 inline Bounds positive_fraction() { return {0.0, 1.0, true, false}; }
 
-// Visits each of `fields` under its name in `spelled`, the preprocessor's spelling of the
-// arguments ("o.a, o.b"), within `bounds` (HYBRID_VO_FIELDS).
-template <typename Visit, typename... Fields>
-void visit_named(Visit& visit, const Bounds& bounds, const char* spelled, Fields&... fields) {
+// The names of the preprocessor's spelling of HYBRID_VO_FIELDS' arguments: "o.a, o.b" -> a, b.
+inline std::vector<std::string> spelled_field_names(const char* spelled) {
   std::vector<std::string> names;
   std::istringstream list(spelled);
   for (std::string name; std::getline(list, name, ',');)
-    names.push_back(name.substr(name.find('.') + 1));  // "o.a" or " o.a" -> "a"
+    names.push_back(name.substr(name.find('.') + 1));
+  return names;
+}
+
+// Visits each of `fields` under its name, within `bounds` (HYBRID_VO_FIELDS).
+template <typename Visit, typename... Fields>
+void visit_named(Visit& visit, const Bounds& bounds, const std::vector<std::string>& names,
+                 Fields&... fields) {
   size_t k = 0;
   (visit(names[k++], fields, bounds), ...);
 }

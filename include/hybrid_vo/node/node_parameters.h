@@ -1,9 +1,9 @@
 #pragma once
 
+#include <xmlrpcpp/XmlRpcValue.h>
+
 #include <string>
 #include <vector>
-
-#include <xmlrpcpp/XmlRpcValue.h>
 
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/option_fields.h"
