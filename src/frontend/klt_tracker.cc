@@ -136,7 +136,12 @@ void KltTracker::search_range(const std::vector<cv::Mat>& pyramid, int begin, in
   // Forward: short searches from the predictions; what they lose, and what has no prediction,
   // the long way.
   std::vector<int> short_search, long_search;
-  for (int i = begin; i < end; ++i) (s->predicted[i] ? short_search : long_search).push_back(i);
+  const cv::Rect2f bounds(0.0f, 0.0f, pyramid[0].cols - 1.0f, pyramid[0].rows - 1.0f);
+  for (int i = begin; i < end; ++i) {
+    if (s->predicted[i] && options_.drop_leaving && !bounds.contains(s->predicted_at[i]))
+      continue;  // lost without a search (found stays 0)
+    (s->predicted[i] ? short_search : long_search).push_back(i);
+  }
   search(previous_, pyramid, points_, short_search, s->short_levels, options_, &s->next,
          &s->found);
   for (int i : short_search)
@@ -149,7 +154,6 @@ void KltTracker::search_range(const std::vector<cv::Mat>& pyramid, int begin, in
   // backward search mirrors the forward one: a feature found the short way is searched for
   // back from its position minus the predicted motion, over the same levels. A feature found
   // outside the image is lost whatever the way back says, so it is not searched for.
-  const cv::Rect2f bounds(0.0f, 0.0f, pyramid[0].cols - 1.0f, pyramid[0].rows - 1.0f);
   std::vector<int> back_short, back_long;
   for (int i = begin; i < end; ++i) {
     if (!s->found[i] || !bounds.contains(s->next[i])) continue;

@@ -288,14 +288,14 @@ std::vector<StereoScaleObservation> VisualOdometry::refine_scale_points(
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   const double caller_cpu_start = thread_cpu_ms(), worker_cpu_start = worker_->cpu_ms();
-  VisualOdometryResult r = process_frame(input);
+  VisualOdometryResult r = run_frame(input);
   // Each thread's CPU time for this frame: every job of the frame is done by now.
   r.stages.caller_cpu_ms = thread_cpu_ms() - caller_cpu_start;
   r.stages.worker_cpu_ms = worker_->cpu_ms() - worker_cpu_start;
   return r;
 }
 
-VisualOdometryResult VisualOdometry::process_frame(const VisualOdometryInput& input) {
+VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input) {
   const auto start = std::chrono::steady_clock::now();
   VisualOdometryResult r;
   r.R_wc = R_wc_;

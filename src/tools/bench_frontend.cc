@@ -19,6 +19,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "hybrid_vo/datasets/kitti.h"
@@ -38,13 +39,18 @@ void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
-               " [--no-anchor] [--no-vp-tracker] [--seed S] [--verbose]\n"
+               " [--search-leaving] [--no-anchor] [--no-vp-tracker] [--seed S] [--opencv-threads N]"
+               " [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
-               "  the KLT corners' strength floor (0: every corner); --no-anchor: no orientation\n"
+               "  the KLT corners' strength floor (0: every corner); --search-leaving: KLT searches\n"
+               "  the features predicted outside the image too; --no-anchor: no orientation\n"
                "  anchoring by the VP tracks. Default preset hybrid+junc.\n"
+               "  --opencv-threads N: OpenCV's own thread pool (cv::setNumThreads), as the node's\n"
+               "  opencv_threads parameter; default 1 (none: the front end splits its work over\n"
+               "  its two threads itself); -1 leaves OpenCV's default.\n"
                "  --trajectory: every frame's camera pose in the odometry frame, TUM format\n"
                "  (timestamp tx ty tz qx qy qz qw; stamps from times.txt + 1 s, as kitti_to_bag\n"
                "  writes them).\n"
@@ -138,6 +144,7 @@ int run(int argc, char** argv) {
   int vp_min_inliers = 6;
   std::string trajectory_path;
   int direct_gap = 0;
+  int opencv_threads = 1;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -148,6 +155,7 @@ int run(int argc, char** argv) {
     else if (a == "--min-corner-gradient" && i + 1 < argc)
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--no-predict") o.klt.predict_motion = false;
+    else if (a == "--search-leaving") o.klt.drop_leaving = false;
     else if (a == "--stereo") stereo = true;
     else if (a == "--klt-window" && i + 1 < argc) o.klt.window_px = std::atoi(argv[++i]);
     else if (a == "--klt-iterations" && i + 1 < argc) o.klt.max_iterations = std::atoi(argv[++i]);
@@ -164,6 +172,7 @@ int run(int argc, char** argv) {
         return 2;
       }
     }
+    else if (a == "--opencv-threads" && i + 1 < argc) opencv_threads = std::atoi(argv[++i]);
     else if (a == "--seed" && i + 1 < argc)
       o.estimator.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
@@ -179,6 +188,8 @@ int run(int argc, char** argv) {
       return 2;
     }
   }
+  // As the node does (its opencv_threads parameter).
+  if (opencv_threads >= 0) cv::setNumThreads(opencv_threads);
   if (!preset_options(preset, &o.estimator.estimator)) {
     std::cerr << "unknown preset " << preset << "\n";
     return 2;

@@ -43,6 +43,10 @@ struct KltTrackerOptions {
   // does not start the short search at half the true motion (up to kMaxMotionScale).
   bool predict_motion = true;
   int predicted_pyramid_levels = 1;
+  // A feature predicted to lie outside the image has left it: it is dropped without a search. On
+  // KITTI 130 features a frame are, and a long search each found 4 of them inside again, for 8 %
+  // of the front end's instructions (same AUC and drift: README, "Throughput").
+  bool drop_leaving = true;
 };
 
 // Re-detection's work, cell by cell (KltTracker::plan_detection, detect_cell, add_detections).

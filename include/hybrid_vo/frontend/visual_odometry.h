@@ -211,7 +211,9 @@ class VisualOdometry {
                      const std::vector<int64_t>& line_ids, StereoPair stereo,
                      std::vector<int64_t> pending);
 
-  VisualOdometryResult process_frame(const VisualOdometryInput& input);
+  // process() without the threads' CPU times (not named process*: callgrind's
+  // --toggle-collect='hybrid_vo::VisualOdometry::process*' would toggle twice).
+  VisualOdometryResult run_frame(const VisualOdometryInput& input);
 
   // The scale's observations of an estimated pair: the keyframe's stereo points among the
   // pose's point inliers, seen again (with their current disparities when known).
