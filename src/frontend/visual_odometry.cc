@@ -216,10 +216,11 @@ void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::M
 std::vector<StereoScaleObservation> VisualOdometry::scale_observations(
     const VisualOdometryInput& input, const cv::Mat& gray, const TwoViewMatches& m,
     const std::vector<int64_t>& point_ids, const std::vector<char>& inliers,
-    const std::map<int64_t, Eigen::Vector2d>& points,
-    const std::map<int64_t, Eigen::Vector3d>& current3d, bool tracking) const {
+    const std::map<int64_t, Eigen::Vector2d>& points, bool tracking,
+    std::vector<int64_t>* observed) const {
   std::vector<StereoScaleObservation> observations;
-  std::vector<int64_t> ids;
+  std::vector<int64_t>& ids = *observed;
+  ids.clear();
   // The points were triangulated as Z = fx b / d.
   const double fx_baseline = keyframe_.camera.pinhole.fx * input.baseline_m;
   for (size_t i = 0; i < m.points.size() && i < point_ids.size(); ++i) {
@@ -230,20 +231,30 @@ std::vector<StereoScaleObservation> VisualOdometry::scale_observations(
     o.x_ref = keyframe_.camera.pinhole.normalize(m.points[i].x1);
     o.disparity_ref = fx_baseline / it->second.z();
     o.x_cur = input.camera.pinhole.normalize(m.points[i].x2);
-    const auto now = current3d.find(point_ids[i]);
-    if (options_.stereo_current_disparity && now != current3d.end())
-      o.disparity_cur = input.camera.pinhole.fx * input.baseline_m / now->second.z();
     observations.push_back(o);
     ids.push_back(point_ids[i]);
   }
   if (!tracking || !options_.stereo_refine_tracks || keyframe_.image.empty()) return observations;
-  return refine_scale_points(input, gray, points, ids, std::move(observations));
+  return refine_scale_points(input, gray, points, &ids, std::move(observations));
+}
+
+void VisualOdometry::add_current_disparities(
+    const VisualOdometryInput& input, const std::vector<int64_t>& ids,
+    const std::map<int64_t, Eigen::Vector3d>& current3d,
+    std::vector<StereoScaleObservation>* observations) const {
+  if (!options_.stereo_current_disparity) return;
+  const double fx_baseline = input.camera.pinhole.fx * input.baseline_m;
+  for (size_t k = 0; k < ids.size() && k < observations->size(); ++k) {
+    const auto now = current3d.find(ids[k]);
+    if (now != current3d.end()) (*observations)[k].disparity_cur = fx_baseline / now->second.z();
+  }
 }
 
 std::vector<StereoScaleObservation> VisualOdometry::refine_scale_points(
     const VisualOdometryInput& input, const cv::Mat& gray,
-    const std::map<int64_t, Eigen::Vector2d>& points, const std::vector<int64_t>& ids,
+    const std::map<int64_t, Eigen::Vector2d>& points, std::vector<int64_t>* observed,
     std::vector<StereoScaleObservation> observations) const {
+  const std::vector<int64_t>& ids = *observed;
   // Only the points that can scale the motion, nearer than the fit's depth limit with a margin
   // for the disparity offset: a farther point moves and grows little between frames (on the
   // rendered corridor the tracker's lag beyond 40 baselines is 0.001 px), and on a highway most
@@ -281,8 +292,13 @@ std::vector<StereoScaleObservation> VisualOdometry::refine_scale_points(
           input.camera.has_distortion() ? input.camera.undistort(to[j]) : to[j]);
   }
   std::vector<StereoScaleObservation> kept;
-  for (size_t k = 0; k < observations.size(); ++k)
-    if (keep[k]) kept.push_back(observations[k]);
+  std::vector<int64_t> kept_ids;
+  for (size_t k = 0; k < observations.size(); ++k) {
+    if (!keep[k]) continue;
+    kept.push_back(observations[k]);
+    kept_ids.push_back(ids[k]);
+  }
+  *observed = std::move(kept_ids);
   return kept;
 }
 
@@ -453,7 +469,8 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   if (input.external.has_lines) {
     for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i) {
       const auto it = keyframe_.external_lines.find(input.external.line_ids[i]);
-      if (it != keyframe_.external_lines.end()) m.lines.push_back({it->second, input.external.lines[i]});
+      if (it != keyframe_.external_lines.end())
+        m.lines.push_back({it->second, input.external.lines[i]});
     }
   } else if (options_.use_lines) {
     const auto matching_start = std::chrono::steady_clock::now();
@@ -546,7 +563,18 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   }
 
   // Orientation: the pair's rotation, anchored by the VP tracks it sees (VpTracker::anchor).
+  // The scale's observations, their current points refined on this thread while the second one
+  // still matches the stereo points (then it re-detects while this one fits the scale); then
+  // this frame's disparities.
+  std::vector<StereoScaleObservation> observations;
+  std::vector<int64_t> observed;
+  const auto refine_start = std::chrono::steady_clock::now();
+  if (stereo)
+    observations = scale_observations(input, gray, m, point_ids, est.point_inliers, points,
+                                      tracking, &observed);
+  times.scale_ms = ms_since(refine_start);
   std::map<int64_t, Eigen::Vector3d> current3d = match_stereo();
+  if (stereo) add_current_disparities(input, observed, current3d, &observations);
   RelativePose pose = est.pose;
   std::vector<VpObservation> seen;  // the VPs the pose accepts, as seen in image 2
   if (options_.use_vp_tracker) {
@@ -596,8 +624,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   if (stereo) {
     r.stereo_scale_attempted = true;
     const auto scale_start = std::chrono::steady_clock::now();
-    r.scale_observations = scale_observations(input, gray, m, point_ids, est.point_inliers,
-                                              points, current3d, tracking);
+    r.scale_observations = std::move(observations);
     const StereoRig rig{input.camera.pinhole.fx, input.camera.pinhole.fy, input.baseline_m};
     offset_filter_.update(pose, rig, r.scale_observations, options_.stereo_scale);
     StereoScaleOptions scale_options = options_.stereo_scale;
@@ -608,7 +635,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
       scale_sigma = r.stereo_scale.sigma;
       r.scale_known = true;
     }
-    times.scale_ms = ms_since(scale_start);
+    times.scale_ms += ms_since(scale_start);
   }
   r.motion.t = pose.t * scale;
   if (est.covariance_valid) {

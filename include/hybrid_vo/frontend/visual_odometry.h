@@ -216,19 +216,24 @@ class VisualOdometry {
   VisualOdometryResult run_frame(const VisualOdometryInput& input);
 
   // The scale's observations of an estimated pair: the keyframe's stereo points among the
-  // pose's point inliers, seen again (with their current disparities when known).
+  // pose's point inliers, seen again; `observed` receives their ids.
   std::vector<StereoScaleObservation> scale_observations(
       const VisualOdometryInput& input, const cv::Mat& gray, const TwoViewMatches& m,
       const std::vector<int64_t>& point_ids, const std::vector<char>& inliers,
-      const std::map<int64_t, Eigen::Vector2d>& points,
-      const std::map<int64_t, Eigen::Vector3d>& current3d, bool tracking) const;
-  // Their current points (of KLT tracks `ids`, at `points` in this frame) re-tracked from the
-  // keyframe with an affine window (refine_tracks_affine); the near ones that cannot be are
-  // left out.
+      const std::map<int64_t, Eigen::Vector2d>& points, bool tracking,
+      std::vector<int64_t>* observed) const;
+  // Their current points (of KLT tracks `observed`, at `points` in this frame) re-tracked from
+  // the keyframe with an affine window (refine_tracks_affine), on both threads; the near ones
+  // that cannot be are left out (of `observed` too).
   std::vector<StereoScaleObservation> refine_scale_points(
       const VisualOdometryInput& input, const cv::Mat& gray,
-      const std::map<int64_t, Eigen::Vector2d>& points, const std::vector<int64_t>& ids,
+      const std::map<int64_t, Eigen::Vector2d>& points, std::vector<int64_t>* observed,
       std::vector<StereoScaleObservation> observations) const;
+  // This frame's disparities of the observations of `ids` (stereo_current_disparity), where
+  // `current3d` has them.
+  void add_current_disparities(const VisualOdometryInput& input, const std::vector<int64_t>& ids,
+                               const std::map<int64_t, Eigen::Vector3d>& current3d,
+                               std::vector<StereoScaleObservation>* observations) const;
 
   // Every feature the KLT tracker holds, by id.
   std::map<int64_t, Eigen::Vector2d> klt_points() const;
