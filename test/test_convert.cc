@@ -25,6 +25,7 @@
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 
@@ -35,6 +36,7 @@
 #include "hybrid_vo/conversion/lamar_to_bag.h"
 #include "hybrid_vo/datasets/kitti.h"
 #include "hybrid_vo/datasets/readers.h"
+#include "hybrid_vo/frontend/image_codec.h"
 #include "hybrid_vo/render/sequence.h"
 
 namespace hybrid_vo {
@@ -57,6 +59,7 @@ using testing::write_file;
 
 struct BagData {
   std::map<std::string, std::vector<sensor_msgs::Image>> images;  // by topic
+  std::map<std::string, std::vector<sensor_msgs::CompressedImage>> compressed;
   std::map<std::string, std::vector<sensor_msgs::CameraInfo>> infos;
   std::vector<geometry_msgs::PoseStamped> ground_truth;
   std::vector<geometry_msgs::TransformStamped> tf, tf_static;
@@ -69,6 +72,9 @@ BagData read_bag(const std::string& path) {
   for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
     if (const auto image = m.instantiate<sensor_msgs::Image>()) {
       data.images[m.getTopic()].push_back(*image);
+      EXPECT_EQ(m.getTime(), image->header.stamp) << m.getTopic();
+    } else if (const auto image = m.instantiate<sensor_msgs::CompressedImage>()) {
+      data.compressed[m.getTopic()].push_back(*image);
       EXPECT_EQ(m.getTime(), image->header.stamp) << m.getTopic();
     } else if (const auto info = m.instantiate<sensor_msgs::CameraInfo>()) {
       data.infos[m.getTopic()].push_back(*info);
@@ -374,8 +380,11 @@ TEST(KittiToBag, Executable) {
   fixture.times[1] = "1.000000e-01";
   fixture.write();
   EXPECT_EQ(run(command, &output), 0) << output;
-  EXPECT_TRUE(contains(output, "converted 5 frames (mono, 160x96), ground truth from"));
+  EXPECT_TRUE(contains(output, "converted 5 frames (mono, 160x96, raw images), ground truth from"));
   EXPECT_EQ(read_bag(bag.string()).ground_truth.size(), 5u);
+  EXPECT_EQ(run(command + " --compressed png", &output), 0) << output;
+  EXPECT_TRUE(contains(output, "converted 5 frames (mono, 160x96, png images)"));
+  EXPECT_EQ(read_bag(bag.string()).compressed.at("/camera/left/image_raw/compressed").size(), 5u);
   // A relative sequence folder still finds <root>/poses.
   const std::string relative = "cd " + (dir.path() / "sequences").string() + " && " + tool +
                                " --sequence 07 --out " + bag.string();
@@ -487,6 +496,76 @@ TEST(RenderSequence, KittiDirRoundTripsThroughTheReadersAndTheConverter) {
   EXPECT_TRUE(contains(output, "already exists")) << output;
 }
 
+// --compressed: CompressedImage topics as compressed_image_transport publishes them, instead of
+// the raw ones; PNG holds the images exactly, JPEG closely, and a lower quality makes it smaller.
+TEST(KittiToBag, CompressedImagesOnTheCompressedTopics) {
+  TempDir dir("test_convert");
+  KittiFixture fixture(dir.path(), kitti_rendering());
+  fixture.write();
+  const Rendered& r = kitti_rendering();
+  std::map<int, size_t> jpeg_bytes;  // by quality
+  for (const auto& [codec, quality] : std::vector<std::pair<std::string, int>>{
+           {"png", 95}, {"jpeg", 95}, {"jpeg", 50}}) {
+    SCOPED_TRACE(codec + " " + std::to_string(quality));
+    KittiBagOptions options;
+    ASSERT_EQ(parse_kitti_args({"--sequence", fixture.sequence_dir().string(), "--out",
+                                (dir.path() / "out.bag").string(), "--stereo", "--compressed",
+                                codec, "--jpeg-quality", std::to_string(quality)},
+                               &options),
+              "");
+    std::string error;
+    ASSERT_TRUE(convert_kitti(options, &error)) << error;
+    const BagData bag = read_bag(options.out_bag);
+    EXPECT_TRUE(bag.images.empty()) << "no raw images beside the compressed ones";
+    for (const std::string side : {"left", "right"}) {
+      SCOPED_TRACE(side);
+      const auto& images = bag.compressed.at("/camera/" + side + "/image_raw/compressed");
+      ASSERT_EQ(images.size(), 5u);
+      EXPECT_EQ(bag.infos.at("/camera/" + side + "/camera_info").size(), 5u);
+      for (int i = 0; i < 5; ++i) {
+        EXPECT_EQ(images[i].header.stamp, ros::Time(1.0 + fixture.time(i)));
+        EXPECT_EQ(images[i].header.frame_id, "camera_" + side + "_optical");
+        EXPECT_EQ(images[i].format, codec == "png" ? "mono8; png compressed "
+                                                   : "mono8; jpeg compressed mono8");
+        const cv::Mat& truth = side == "left" ? r.left_images[i] : r.right_images[i];
+        cv::Mat decoded;
+        ASSERT_TRUE(decode_gray8(images[i].data, &decoded, &error, truth.cols, truth.rows))
+            << error;
+        if (codec == "png") {
+          EXPECT_TRUE(same_image(decoded, truth));
+        } else {
+          cv::Mat difference;
+          cv::absdiff(decoded, truth, difference);
+          EXPECT_LT(cv::mean(difference)[0], quality == 95 ? 1.5 : 4.0);
+          jpeg_bytes[quality] += images[i].data.size();
+        }
+      }
+    }
+  }
+  EXPECT_LT(jpeg_bytes[50], jpeg_bytes[95]);
+}
+
+TEST(KittiToBag, CompressedArguments) {
+  auto problem = [](const std::vector<std::string>& extra) {
+    KittiBagOptions fresh;
+    std::vector<std::string> args = {"--sequence", "s", "--out", "o.bag"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return parse_kitti_args(args, &fresh);
+  };
+  EXPECT_EQ(problem({"--compressed", "gif"}), "bad value 'gif' for --compressed (png or jpeg)");
+  EXPECT_EQ(problem({"--jpeg-quality", "0"}), "bad value '0' for --jpeg-quality (1..100)");
+  EXPECT_EQ(problem({"--jpeg-quality", "9x"}), "bad value '9x' for --jpeg-quality (1..100)");
+  KittiBagOptions o;
+  EXPECT_EQ(parse_kitti_args({"--sequence", "s", "--out", "o", "--compressed", "jpeg"}, &o), "");
+  EXPECT_EQ(o.images.kind, BagImageFormat::kJpeg);
+  EXPECT_EQ(o.images.jpeg_quality, 95);
+  LamarBagOptions l;
+  EXPECT_EQ(parse_lamar_args({"--session", "s", "--out", "o", "--compressed", "png"}, &l), "");
+  EXPECT_EQ(l.images.kind, BagImageFormat::kPng);
+  EXPECT_EQ(parse_lamar_args({"--session", "s", "--out", "o", "--compressed", "raw"}, &l),
+            "bad value 'raw' for --compressed (png or jpeg)");
+}
+
 // ------------------------------------------------------------------------------------------------
 // LaMAR
 
@@ -550,6 +629,19 @@ TEST(LamarToBag, RigOfTwoCamerasRoundTrips) {
   ASSERT_EQ(right.ground_truth.size(), 5u);
   for (int i = 0; i < 5; ++i) expect_pose(right.ground_truth[i].pose, r.right[i], 1e-9);
   EXPECT_EQ(right.tf_static.size(), 1u);
+
+  // --compressed png: the same images, on the compressed topic.
+  options.images.kind = BagImageFormat::kPng;
+  ASSERT_TRUE(convert_lamar(options, &error, &summary)) << error;
+  const BagData compressed = read_bag(options.out_bag);
+  EXPECT_TRUE(compressed.images.empty());
+  const auto& images = compressed.compressed.at("/camera/cam_right/image_raw/compressed");
+  ASSERT_EQ(images.size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    cv::Mat decoded;
+    ASSERT_TRUE(decode_gray8(images[i].data, &decoded, &error)) << error;
+    EXPECT_TRUE(same_image(decoded, r.right_images[i]));
+  }
 }
 
 // A phone session as run_phone_to_capture writes it: one camera per frame with its own focal

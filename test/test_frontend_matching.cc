@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hybrid_vo/frontend/camera_model.h"
+#include "hybrid_vo/frontend/fisheye_rectifier.h"
 #include "hybrid_vo/frontend/line_matching.h"
 #include "hybrid_vo/frontend/point_matching.h"
 
@@ -450,6 +451,188 @@ TEST(CameraModel, UndistortMatchesUndistortsEachImageWithItsCamera) {
   EXPECT_LT((matches.lines[0].s2.p1 - truth.lines[0].s2.p1).norm(), 1e-6);
   EXPECT_EQ(matches.vps[0].d1, truth.vps[0].d1);
   undistort_matches(camera1, camera2, nullptr);  // no crash
+}
+
+// A 150-degree equidistant lens on a 640 x 480 image (the renderer's fisheye), with real
+// coefficients: theta_d = theta (1 - 0.02 theta^2 + 0.003 theta^4 ...).
+CameraModel fisheye_150() {
+  CameraModel c;
+  c.model = LensModel::kEquidistant;
+  c.distortion = {-0.02, 0.003, -0.0005, 0.0001, 0.0};
+  const double half = 75.0 * M_PI / 180.0;
+  const double theta_d = half * (1 - 0.02 * half * half + 0.003 * std::pow(half, 4) -
+                                 0.0005 * std::pow(half, 6) + 0.0001 * std::pow(half, 8));
+  const double f = 319.5 / theta_d;
+  c.pinhole = PinholeCamera(f, f, 319.5, 239.5, 640, 480);
+  return c;
+}
+
+cv::Matx33d K_of(const PinholeCamera& p) { return {p.fx, 0, p.cx, 0, p.fy, p.cy, 0, 0, 1}; }
+
+TEST(CameraModel, EquidistantAgreesWithOpenCvFisheye) {
+  const CameraModel camera = fisheye_150();
+  EXPECT_TRUE(camera.has_distortion());
+  EXPECT_EQ(camera_model_problem(camera), "");
+  const cv::Vec4d D(camera.distortion[0], camera.distortion[1], camera.distortion[2],
+                    camera.distortion[3]);
+  // Forward: undistorted normalised points through cv::fisheye::distortPoints.
+  std::vector<cv::Point2d> normalised, distorted;
+  for (double x = -3.0; x <= 3.0; x += 0.25)
+    for (double y = -2.0; y <= 2.0; y += 0.25) normalised.emplace_back(x, y);
+  cv::fisheye::distortPoints(normalised, distorted, K_of(camera.pinhole), D);
+  double worst = 0.0;
+  for (size_t k = 0; k < normalised.size(); ++k) {
+    const Eigen::Vector2d ours =
+        camera.distort(camera.pinhole.denormalize({normalised[k].x, normalised[k].y}));
+    worst = std::max(worst, (ours - Eigen::Vector2d(distorted[k].x, distorted[k].y)).norm());
+  }
+  EXPECT_LT(worst, 1e-6);
+  // Backward: pixels whose rays are in front, through cv::fisheye::undistortPoints.
+  std::vector<cv::Point2d> pixels, undistorted;
+  for (double x = 0; x < 640; x += 40)
+    for (double y = 0; y < 480; y += 40)
+      if (camera.ray({x, y}).z() > 0.1) pixels.emplace_back(x, y);
+  cv::fisheye::undistortPoints(pixels, undistorted, K_of(camera.pinhole), D, cv::noArray(),
+                               K_of(camera.pinhole),
+                               cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                                100, 1e-12));
+  worst = 0.0;
+  for (size_t k = 0; k < pixels.size(); ++k) {
+    const Eigen::Vector2d ours = camera.undistort({pixels[k].x, pixels[k].y});
+    worst = std::max(worst, (ours - Eigen::Vector2d(undistorted[k].x, undistorted[k].y)).norm());
+  }
+  EXPECT_LT(worst, 1e-4);
+}
+
+// Every pixel of the image: distort(undistort(p)) returns to p within 0.01 px where a pinhole
+// pixel exists (rays less than 90 degrees off the axis), project(ray(p)) everywhere, and the
+// pixels beyond 90 degrees (the 150-degree lens' corners reach 95) have no pinhole pixel.
+TEST(CameraModel, EquidistantUndistortionRoundTripOverTheImage) {
+  const CameraModel camera = fisheye_150();
+  double worst = 0.0, worst_ray = 0.0, widest = 0.0;
+  int pinhole_pixels = 0, beyond = 0;
+  for (int y = 0; y < 480; ++y) {
+    for (int x = 0; x < 640; ++x) {
+      const Eigen::Vector2d p(x, y);
+      const Eigen::Vector3d ray = camera.ray(p);
+      ASSERT_TRUE(all_finite(ray)) << x << ", " << y;
+      widest = std::max(widest, std::acos(ray.z()) * 180.0 / M_PI);
+      Eigen::Vector2d back;
+      ASSERT_TRUE(camera.project(3.0 * ray, &back));
+      worst_ray = std::max(worst_ray, (back - p).norm());
+      const Eigen::Vector2d u = camera.undistort(p);
+      if (ray.z() > 1e-3) {
+        ASSERT_TRUE(all_finite(u)) << x << ", " << y;
+        worst = std::max(worst, (camera.distort(u) - p).norm());
+        ++pinhole_pixels;
+      } else if (ray.z() < -1e-3) {
+        EXPECT_FALSE(all_finite(u)) << x << ", " << y;
+        ++beyond;
+      }
+    }
+  }
+  EXPECT_LT(worst, 0.01);
+  EXPECT_LT(worst_ray, 0.01);
+  EXPECT_GT(widest, 93.0);  // the corners see behind the image plane
+  EXPECT_LT(widest, 96.0);
+  EXPECT_GT(beyond, 100);
+  EXPECT_GT(pinhole_pixels, 300000);
+  // The horizontal field of view is 150 degrees: the image's left and right edges at 75.
+  EXPECT_NEAR(std::acos(camera.ray({319.5 - 319.5, 239.5}).z()) * 180.0 / M_PI, 75.0, 1e-6);
+  // Matches beyond 90 degrees become NaN, which the estimator leaves out.
+  TwoViewMatches matches;
+  matches.points.push_back({Eigen::Vector2d(0, 0), Eigen::Vector2d(320, 240)});
+  undistort_matches(camera, camera, &matches);
+  EXPECT_FALSE(all_finite(matches.points[0].x1));
+  EXPECT_TRUE(all_finite(matches.points[0].x2));
+}
+
+TEST(CameraModel, EquidistantCoefficientsThatFoldBackAreAProblem) {
+  CameraModel camera = fisheye_150();
+  camera.distortion = {-0.5, 0.0, 0.0, 0.0, 0.0};  // theta_d peaks at sqrt(2/3) rad
+  EXPECT_NE(camera_model_problem(camera).find("fold back at 46.8 deg"), std::string::npos)
+      << camera_model_problem(camera);
+  camera.distortion[0] = std::nan("");
+  EXPECT_EQ(camera_model_problem(camera), "a non-finite distortion coefficient");
+  camera.distortion = {0, 0, 0, 0, 0};  // the ideal equidistant lens
+  EXPECT_EQ(camera_model_problem(camera), "");
+  EXPECT_TRUE(camera.has_distortion());
+}
+
+// Lines straight in space are curves in the fisheye image and straight again in the rectified
+// view; the tables are built once per camera.
+TEST(FisheyeRectifier, StraightLinesComeOutStraight) {
+  const CameraModel camera = fisheye_150();
+  cv::Mat fisheye(480, 640, CV_8UC1, cv::Scalar(0));
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> lines = {
+      {{-3.0, -1.0, 2.0}, {3.0, -1.2, 2.5}},  // across the top, bent by the lens
+      {{-1.5, -2.0, 3.0}, {-1.0, 2.0, 2.0}},
+      {{1.2, 1.5, 1.5}, {2.5, -1.0, 4.0}}};
+  for (const auto& [a, b] : lines) {
+    std::vector<cv::Point> curve;
+    for (int k = 0; k <= 400; ++k) {
+      Eigen::Vector2d p;
+      ASSERT_TRUE(camera.project(a + (b - a) * k / 400.0, &p));
+      curve.emplace_back(static_cast<int>(std::lround(p.x() * 16)),
+                         static_cast<int>(std::lround(p.y() * 16)));
+    }
+    cv::polylines(fisheye, curve, false, cv::Scalar(255), 2, cv::LINE_AA, 4);
+  }
+  FisheyeRectifier rectifier(100.0);
+  cv::Mat rectified;
+  CameraModel view;
+  std::string reason;
+  ASSERT_TRUE(rectifier.rectify(camera, Eigen::Matrix3d::Identity(), fisheye, &rectified, &view,
+                                &reason))
+      << reason;
+  EXPECT_FALSE(view.has_distortion());
+  EXPECT_NEAR(view.pinhole.fx, 320.0 / std::tan(50.0 * M_PI / 180.0), 1e-9);
+  cv::Mat intensity;
+  rectified.convertTo(intensity, CV_32F);
+  for (const auto& [a, b] : lines) {
+    // Across the straight line between the endpoints' pinhole pixels, the drawn curve's centre
+    // (the intensity centroid within 10 px) lies on it.
+    const Eigen::Vector2d pa = view.pinhole.denormalize(a.head<2>() / a.z());
+    const Eigen::Vector2d pb = view.pinhole.denormalize(b.head<2>() / b.z());
+    const Eigen::Vector2d normal = Eigen::Vector2d(pa.y() - pb.y(), pb.x() - pa.x()).normalized();
+    int inside = 0;
+    double worst = 0.0;
+    for (int k = 1; k < 100; ++k) {
+      const Eigen::Vector2d p = pa + (pb - pa) * k / 100.0;
+      if (p.x() < 12 || p.y() < 12 || p.x() > 627 || p.y() > 467) continue;
+      ++inside;
+      double sum = 0.0, moment = 0.0;
+      for (double d = -10.0; d <= 10.0; d += 0.25) {
+        const Eigen::Vector2d q = p + d * normal;
+        cv::Mat patch;
+        cv::getRectSubPix(intensity, cv::Size(1, 1), cv::Point2f(q.x(), q.y()), patch);
+        sum += patch.at<float>(0, 0);
+        moment += d * patch.at<float>(0, 0);
+      }
+      ASSERT_GT(sum, 0.0) << "no line near " << p.transpose();
+      worst = std::max(worst, std::abs(moment / sum));
+    }
+    EXPECT_GT(inside, 30);
+    EXPECT_LT(worst, 0.5);
+  }
+  // Same camera: no new tables; another one (or another rotation): new tables.
+  ASSERT_TRUE(rectifier.rectify(camera, Eigen::Matrix3d::Identity(), fisheye, &rectified, &view,
+                                &reason));
+  EXPECT_EQ(rectifier.maps_built(), 1);
+  CameraModel other = camera;
+  other.distortion[0] = -0.021;
+  ASSERT_TRUE(rectifier.rectify(other, Eigen::Matrix3d::Identity(), fisheye, &rectified, &view,
+                                &reason));
+  EXPECT_EQ(rectifier.maps_built(), 2);
+  // Refused: a pinhole camera, an image of another size, a field of view of 180 degrees.
+  EXPECT_FALSE(rectifier.rectify(kitti_like_camera(), Eigen::Matrix3d::Identity(), fisheye,
+                                 &rectified, &view, &reason));
+  EXPECT_FALSE(rectifier.rectify(camera, Eigen::Matrix3d::Identity(), fisheye(cv::Rect(0, 0, 320, 240)),
+                                 &rectified, &view, &reason));
+  EXPECT_EQ(reason, "the image is not the camera's size");
+  FisheyeRectifier flat(180.0);
+  EXPECT_FALSE(flat.rectify(camera, Eigen::Matrix3d::Identity(), fisheye, &rectified, &view,
+                            &reason));
 }
 
 // Degenerate input: empty results, no crash.

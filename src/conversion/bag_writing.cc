@@ -4,17 +4,22 @@
 
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
 
 #include <cv_bridge/cv_bridge.h>
 #include <Eigen/Geometry>
 #include <geometry_msgs/PoseStamped.h>
 #include <opencv2/imgcodecs.hpp>
 #include <rosbag/exceptions.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_msgs/TFMessage.h>
+
+#include "hybrid_vo/frontend/image_codec.h"
 
 namespace hybrid_vo {
 namespace conversion {
@@ -130,13 +135,51 @@ bool BagOutput::commit(std::string* error) {
   return true;
 }
 
+bool parse_compressed_images(const std::string& value, BagImageFormat* format) {
+  if (value == "png") format->kind = BagImageFormat::kPng;
+  else if (value == "jpeg" || value == "jpg") format->kind = BagImageFormat::kJpeg;
+  else return false;
+  return true;
+}
+
+bool parse_jpeg_quality(const std::string& value, BagImageFormat* format) {
+  char* end = nullptr;
+  const long quality = std::strtol(value.c_str(), &end, 10);
+  if (value.empty() || *end || quality < 1 || quality > 100) return false;
+  format->jpeg_quality = static_cast<int>(quality);
+  return true;
+}
+
+const char* to_string(BagImageFormat::Kind kind) {
+  switch (kind) {
+    case BagImageFormat::kPng: return "png";
+    case BagImageFormat::kJpeg: return "jpeg";
+    case BagImageFormat::kRaw: break;
+  }
+  return "raw";
+}
+
 void BagOutput::write_image(const std::string& topic, const std::string& frame,
                             const ros::Time& stamp, const cv::Mat& mono8) {
   std_msgs::Header header;
   header.stamp = stamp;
   header.frame_id = frame;
-  bag_.write(topic, stamp,
-             *cv_bridge::CvImage(header, sensor_msgs::image_encodings::MONO8, mono8).toImageMsg());
+  if (image_format_.kind == BagImageFormat::kRaw) {
+    bag_.write(topic, stamp,
+               *cv_bridge::CvImage(header, sensor_msgs::image_encodings::MONO8, mono8).toImageMsg());
+    return;
+  }
+  sensor_msgs::CompressedImage image;
+  image.header = header;
+  const bool png = image_format_.kind == BagImageFormat::kPng;
+  // compressed_image_transport's format field: "<encoding>; <codec> compressed [<target>]".
+  image.format = png ? "mono8; png compressed " : "mono8; jpeg compressed mono8";
+  const std::vector<int> params =
+      png ? std::vector<int>{} : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, image_format_.jpeg_quality};
+  if (!cv::imencode(png ? ".png" : ".jpg", mono8, image.data, params))
+    throw std::runtime_error(std::string("cannot encode ") + to_string(image_format_.kind) +
+                             " for " + topic);
+  bag_.write(topic + "/compressed", stamp, image);
 }
 
 void BagOutput::write_ground_truth(const std::string& child, const ros::Time& stamp,
@@ -207,31 +250,6 @@ bool read_mono8(const std::string& path, cv::Mat* mono8, int* channels, std::str
     return failed("cannot decode image (" + e.err + ")");
   }
   return true;
-}
-
-bool jpeg_reaches_end(const std::vector<unsigned char>& b) {
-  const size_t n = b.size();
-  if (n < 4 || b[0] != 0xFF || b[1] != 0xD8) return false;
-  auto standalone = [](unsigned char m) { return m == 0x01 || (m >= 0xD0 && m <= 0xD7); };
-  size_t i = 2;  // after SOI
-  while (i + 1 < n) {
-    if (b[i] != 0xFF) return false;  // no marker where one must be
-    const unsigned char marker = b[i + 1];
-    if (marker == 0xFF) {  // fill byte
-      ++i;
-      continue;
-    }
-    i += 2;
-    if (marker == 0xD9) return true;   // EOI
-    if (standalone(marker)) continue;  // TEM, RSTn: no length
-    if (i + 2 > n) return false;
-    const size_t length = (static_cast<size_t>(b[i]) << 8) | b[i + 1];
-    if (length < 2) return false;
-    i += length;
-    if (marker == 0xDA)  // SOS: entropy-coded data follows, up to the next real marker
-      while (i + 1 < n && !(b[i] == 0xFF && b[i + 1] != 0x00 && !standalone(b[i + 1]))) ++i;
-  }
-  return false;
 }
 
 }  // namespace conversion

@@ -58,7 +58,10 @@ std::string kitti_usage(const std::string& program) {
     << "/tf world -> gt_camera_left_optical.\n"
     << "  --poses FILE      camera-to-world poses (default <root>/poses/<name>.txt if present)\n"
     << "  --stereo          also the right camera (image_1, P1)\n"
-    << "  --start-time T    seconds added to times.txt (default 1)\n";
+    << "  --start-time T    seconds added to times.txt (default 1)\n"
+    << "  --compressed png|jpeg  images as sensor_msgs/CompressedImage on .../image_raw/compressed\n"
+    << "                    (as robots record them) instead of raw on .../image_raw\n"
+    << "  --jpeg-quality Q  with --compressed jpeg: quality 1..100 (default 95)\n";
   return s.str();
 }
 
@@ -73,7 +76,8 @@ std::string parse_kitti_args(const std::vector<std::string>& args, KittiBagOptio
       o->stereo = true;
       continue;
     }
-    if (arg != "--sequence" && arg != "--poses" && arg != "--out" && arg != "--start-time")
+    if (arg != "--sequence" && arg != "--poses" && arg != "--out" && arg != "--start-time" &&
+        arg != "--compressed" && arg != "--jpeg-quality")
       return "unknown argument '" + arg + "'";
     if (i + 1 >= args.size() || args[i + 1].empty()) return arg + " needs a value";
     const std::string& v = args[++i];
@@ -82,6 +86,10 @@ std::string parse_kitti_args(const std::vector<std::string>& args, KittiBagOptio
     if (arg == "--out") o->out_bag = v;
     if (arg == "--start-time" && (!datasets::parse_double(v, &o->start_time) || o->start_time < 0))
       return "bad value '" + v + "' for --start-time (seconds, >= 0)";
+    if (arg == "--compressed" && !parse_compressed_images(v, &o->images))
+      return "bad value '" + v + "' for --compressed (png or jpeg)";
+    if (arg == "--jpeg-quality" && !parse_jpeg_quality(v, &o->images))
+      return "bad value '" + v + "' for --jpeg-quality (1..100)";
   }
   if (o->sequence_dir.empty()) return "--sequence DIR is required";
   if (o->out_bag.empty()) return "--out OUT.bag is required";
@@ -123,6 +131,7 @@ bool convert_kitti(const KittiBagOptions& options, std::string* error, KittiBagS
 
   BagOutput out;
   if (!out.open(options.out_bag, rosbag::compression::LZ4, error)) return false;
+  out.set_image_format(options.images);
   const std::string left = optical_frame("left"), right = optical_frame("right");
   const ros::Time t0(options.start_time + times.front());
   const Eigen::Matrix3d R_base_optical = render::base_from_optical();

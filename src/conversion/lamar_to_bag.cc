@@ -99,7 +99,10 @@ std::string lamar_usage(const std::string& program) {
     << "                    in sensors.txt order); a phone's per-frame cameras <id>_<timestamp>\n"
     << "                    are the one camera <id>\n"
     << "  --time-offset S   seconds added to the timestamps (default: 1 when the session's\n"
-    << "                    timestamps start below 1 s, else 0)\n";
+    << "                    timestamps start below 1 s, else 0)\n"
+    << "  --compressed png|jpeg  images as sensor_msgs/CompressedImage on .../image_raw/compressed\n"
+    << "                    (as robots record them) instead of raw on .../image_raw\n"
+    << "  --jpeg-quality Q  with --compressed jpeg: quality 1..100 (default 95)\n";
   return s.str();
 }
 
@@ -110,7 +113,8 @@ std::string parse_lamar_args(const std::vector<std::string>& args, LamarBagOptio
       o->help = true;
       return "";
     }
-    if (arg != "--session" && arg != "--out" && arg != "--cameras" && arg != "--time-offset")
+    if (arg != "--session" && arg != "--out" && arg != "--cameras" && arg != "--time-offset" &&
+        arg != "--compressed" && arg != "--jpeg-quality")
       return "unknown argument '" + arg + "'";
     if (i + 1 >= args.size() || args[i + 1].empty()) return arg + " needs a value";
     const std::string& v = args[++i];
@@ -123,6 +127,10 @@ std::string parse_lamar_args(const std::vector<std::string>& args, LamarBagOptio
     if (arg == "--time-offset" &&
         (!datasets::parse_double(v, &o->time_offset) || o->time_offset < 0))
       return "bad value '" + v + "' for --time-offset (seconds, >= 0)";
+    if (arg == "--compressed" && !parse_compressed_images(v, &o->images))
+      return "bad value '" + v + "' for --compressed (png or jpeg)";
+    if (arg == "--jpeg-quality" && !parse_jpeg_quality(v, &o->images))
+      return "bad value '" + v + "' for --jpeg-quality (1..100)";
   }
   if (o->session_dir.empty()) return "--session DIR is required";
   if (o->out_bag.empty()) return "--out OUT.bag is required";
@@ -164,6 +172,7 @@ bool convert_lamar(const LamarBagOptions& options, std::string* error, LamarBagS
 
   BagOutput out;
   if (!out.open(options.out_bag, rosbag::compression::LZ4, error)) return false;
+  out.set_image_format(options.images);
   LamarBagSummary result;
   result.images.assign(streams.size(), 0);
   result.poses_path = session.poses_path;

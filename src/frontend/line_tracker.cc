@@ -46,9 +46,26 @@ double direction_angle(const LineSegment& s) {
 
 double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
+// A segment's endpoints carried by a homography; false when one lands at infinity.
+bool transfer(const Eigen::Matrix3d& H, const LineSegment& s, LineSegment* out) {
+  const Eigen::Vector3d a = H * homogeneous(s.p1), b = H * homogeneous(s.p2);
+  if (!(std::abs(a.z()) > 1e-12) || !(std::abs(b.z()) > 1e-12)) return false;
+  *out = LineSegment(a.head<2>() / a.z(), b.head<2>() / b.z());
+  return all_finite(out->p1) && all_finite(out->p2);
+}
+
+// Both segments' line motion: the foot of a's midpoint on b's line minus the midpoint, and the
+// turn from a's direction to b's.
+void line_motion(const LineSegment& a, const LineSegment& b, Eigen::Vector2d* shift, double* turn) {
+  const Eigen::Vector3d l = line_through(b.p1, b.p2);
+  *shift = -l.dot(homogeneous(a.midpoint())) * l.head<2>();
+  *turn = wrap_angle(direction_angle(b) - direction_angle(a));
+}
+
 }  // namespace
 
-LineTracker::LineTracker(const LineTrackerOptions& options) : options_(options) {}
+LineTracker::LineTracker(const LineTrackerOptions& options, const LineMatchingOptions& matching)
+    : options_(options), matching_(matching) {}
 
 void LineTracker::reset() {
   tracks_.clear();
@@ -56,17 +73,20 @@ void LineTracker::reset() {
   now_ = 0.0;
 }
 
-LineSegment LineTracker::predict(const Track& t, double now) {
-  if (!t.has_motion) return t.segment;
+LineSegment LineTracker::predict(const Track& t, double now, const Eigen::Matrix3d& image_motion) {
+  LineSegment carried;
+  if (!transfer(image_motion, t.segment, &carried)) carried = t.segment;
+  if (!t.has_motion) return carried;
   const double dt = now - t.seen_at;
-  const Eigen::Vector2d mid = t.segment.midpoint();
+  const Eigen::Vector2d mid = carried.midpoint();
   const Eigen::Vector2d moved = mid + dt * t.shift;
   const Eigen::Rotation2Dd turn(dt * t.turn);
-  return LineSegment(moved + turn * (t.segment.p1 - mid), moved + turn * (t.segment.p2 - mid));
+  return LineSegment(moved + turn * (carried.p1 - mid), moved + turn * (carried.p2 - mid));
 }
 
 std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stamp,
-                                        LineTrackingStats* stats) {
+                                        LineTrackingStats* stats,
+                                        const Eigen::Matrix3d& image_motion) {
   LineTrackingStats local;
   LineTrackingStats& st = stats ? *stats : local;
   st = LineTrackingStats();
@@ -76,6 +96,8 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
   started_ = true;
   now_ = now;
   st.tracks = static_cast<int>(tracks_.size());
+  const bool usable = all_finite(image_motion) && std::abs(image_motion.determinant()) > 1e-12;
+  const Eigen::Matrix3d H = usable ? image_motion : Eigen::Matrix3d::Identity();
 
   const int n = static_cast<int>(current.segments.size());
   const bool descriptors = current.descriptors.rows == n && n > 0;
@@ -84,11 +106,14 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
   std::vector<int> chosen(m, -1);
   std::vector<double> score(m, std::numeric_limits<double>::infinity());
   std::vector<Candidate> candidates;
+  std::vector<LineSegment> predictions(m), carried(m);
   for (int k = 0; k < m; ++k) {
     const Track& t = tracks_[k];
-    const LineSegment predicted = predict(t, now);
-    const double motion = std::max((predicted.p1 - t.segment.p1).norm(),
-                                   (predicted.p2 - t.segment.p2).norm());
+    if (!transfer(H, t.segment, &carried[k])) carried[k] = t.segment;
+    const LineSegment& predicted = predictions[k] = predict(t, now, H);
+    // The own motion's guess is uncertain by a fraction of it; the rotation's is not.
+    const double motion = std::max((predicted.p1 - carried[k].p1).norm(),
+                                   (predicted.p2 - carried[k].p2).norm());
     const double tolerance = t.has_motion
                                  ? options_.max_offset_px + options_.motion_fraction * motion
                                  : options_.max_offset_young_px;
@@ -144,29 +169,66 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
   for (int k = 0; k < m; ++k)
     if (chosen[k] >= 0 && (owner[chosen[k]] < 0 || score[k] < score[owner[chosen[k]]]))
       owner[chosen[k]] = k;
+  for (int k = 0; k < m; ++k)
+    if (chosen[k] >= 0 && owner[chosen[k]] != k) chosen[k] = -1;
+
+  // Re-identification of the tracks the search lost, among the segments it left: LBD matching
+  // of every described track against the whole frame, so that its geometric filter sees the
+  // context, of which only the lost tracks' pairs with free segments are taken. It runs when
+  // many are lost at once (a turn starting, a jolt), not for the few a steady frame loses.
+  if (options_.reidentify && descriptors) {
+    LineFeatures described;
+    std::vector<int> track_of_row;
+    int lost = 0;
+    for (int k = 0; k < m; ++k) {
+      const Track& t = tracks_[k];
+      if (t.descriptor.cols != current.descriptors.cols ||
+          t.descriptor.type() != current.descriptors.type())
+        continue;
+      described.segments.push_back(predictions[k]);
+      described.descriptors.push_back(t.descriptor);
+      track_of_row.push_back(k);
+      lost += chosen[k] < 0;
+    }
+    if (lost >= std::max<double>(options_.reidentify_min_lost,
+                         options_.reidentify_min_fraction * static_cast<double>(m))) {
+      std::vector<std::pair<int, int>> pairs;
+      match_line_features(described, current, matching_, &pairs);
+      for (const auto& [row, j] : pairs) {
+        const int k = track_of_row[row];
+        if (chosen[k] >= 0 || owner[j] >= 0) continue;
+        chosen[k] = j;
+        owner[j] = k;
+        ++st.reidentified;
+      }
+    }
+  }
 
   std::vector<Track> kept;
   kept.reserve(m + n);
   for (int k = 0; k < m; ++k) {
     Track t = tracks_[k];
     const int j = chosen[k];
-    if (j < 0 || owner[j] != k) {
+    if (j < 0) {
       if (++t.missed > options_.max_missed_frames) {
         ++st.dropped;
         continue;
       }
+      // Coasting: where it should be now, so that the next frame's rotation carries it on.
+      t.segment = predictions[k];
+      t.seen_at = now;
       kept.push_back(t);
       continue;
     }
     const LineSegment& seen = current.segments[j];
     const double dt = now - t.seen_at;
     if (dt > 0.0) {
-      // The line's motion: the old midpoint to its foot on the new line, and the turn.
-      const Eigen::Vector3d l = line_through(seen.p1, seen.p2);
-      const Eigen::Vector2d mid = t.segment.midpoint();
-      const double distance = l.dot(homogeneous(mid));
-      t.shift = -distance * l.head<2>() / dt;
-      t.turn = wrap_angle(direction_angle(seen) - direction_angle(t.segment)) / dt;
+      // The motion beyond the rotation's: from the carried segment to the one seen.
+      Eigen::Vector2d shift;
+      double turn;
+      line_motion(carried[k], seen, &shift, &turn);
+      t.shift = shift / dt;
+      t.turn = turn / dt;
       t.has_motion = true;
     }
     t.segment = seen;

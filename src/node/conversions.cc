@@ -19,12 +19,18 @@ bool camera_from_info(const sensor_msgs::CameraInfo& info, CameraModel* camera,
     *reason = "camera_info has no valid K or image size";
     return false;
   }
-  const bool known_model = info.distortion_model.empty() ||
-                           info.distortion_model == sensor_msgs::distortion_models::PLUMB_BOB ||
-                           info.distortion_model ==
-                               sensor_msgs::distortion_models::RATIONAL_POLYNOMIAL;
-  if (!known_model) {
-    *reason = "unsupported distortion model '" + info.distortion_model + "'";
+  namespace models = sensor_msgs::distortion_models;
+  const std::string& model = info.distortion_model;
+  // plumb_bob: k1 k2 p1 p2 k3; rational_polynomial adds k4..k6, taken while they are zero;
+  // equidistant: k1..k4.
+  size_t coefficients = 5;
+  if (model == models::EQUIDISTANT) {
+    c.model = LensModel::kEquidistant;
+    coefficients = 4;
+  } else if (!model.empty() && model != models::PLUMB_BOB &&
+             model != models::RATIONAL_POLYNOMIAL) {
+    *reason = "unsupported distortion model '" + model +
+              "' (plumb_bob, rational_polynomial or equidistant)";
     return false;
   }
   for (size_t k = 0; k < info.D.size(); ++k) {
@@ -32,14 +38,34 @@ bool camera_from_info(const sensor_msgs::CameraInfo& info, CameraModel* camera,
       *reason = "camera_info has a non-finite distortion coefficient";
       return false;
     }
-    if (k < 5) {
+    if (k < coefficients) {
       c.distortion[k] = info.D[k];
     } else if (info.D[k] != 0.0) {
-      *reason = "distortion with more than five coefficients is not supported";
+      *reason = "distortion model '" + (model.empty() ? std::string("plumb_bob") : model) +
+                "' with more than " + std::to_string(coefficients) +
+                " coefficients is not supported";
       return false;
     }
   }
+  if (const std::string problem = camera_model_problem(c); !problem.empty()) {
+    *reason = problem;
+    return false;
+  }
   *camera = c;
+  return true;
+}
+
+bool rectification_from_info(const sensor_msgs::CameraInfo& info, Eigen::Matrix3d* R) {
+  Eigen::Matrix3d m;
+  for (int k = 0; k < 9; ++k) m(k / 3, k % 3) = info.R[k];
+  if (m.isZero(0.0)) {
+    *R = Eigen::Matrix3d::Identity();
+    return true;
+  }
+  if (!all_finite(m) || !((m.transpose() * m - Eigen::Matrix3d::Identity()).norm() < 1e-6) ||
+      !(m.determinant() > 0.0))
+    return false;
+  *R = m;
   return true;
 }
 

@@ -1,6 +1,7 @@
 #include "hybrid_vo/node/vo_node.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include <hybrid_vo/MotionEstimate.h>
 #include <hybrid_vo/VanishingPoints.h>
@@ -8,12 +9,40 @@
 #include <opencv2/core/utility.hpp>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "hybrid_vo/node/compressed_image.h"
 #include "hybrid_vo/node/conversions.h"
 
 namespace hybrid_vo {
+namespace {
+
+// For diagnostics: camera_info's model and coefficients, and the pinhole view when the node
+// rectified the image into one.
+std::string describe_camera(const sensor_msgs::CameraInfo& info, const CameraModel& lens,
+                            const CameraModel& used) {
+  const std::string model = info.distortion_model.empty() ? "none" : info.distortion_model;
+  char text[200];
+  if (lens.model != LensModel::kEquidistant) {
+    std::snprintf(text, sizeof(text), "%s%s", model.c_str(),
+                  lens.has_distortion() ? " (features undistorted)" : " (no distortion)");
+  } else if (used.model == LensModel::kEquidistant) {
+    std::snprintf(text, sizeof(text),
+                  "equidistant k1..k4 = %.4g %.4g %.4g %.4g (features undistorted, not rectified)",
+                  lens.distortion[0], lens.distortion[1], lens.distortion[2], lens.distortion[3]);
+  } else {
+    const PinholeCamera& p = used.pinhole;
+    std::snprintf(text, sizeof(text),
+                  "equidistant k1..k4 = %.4g %.4g %.4g %.4g, rectified to a pinhole view of "
+                  "%.0f deg horizontal (f %.1f px)",
+                  lens.distortion[0], lens.distortion[1], lens.distortion[2], lens.distortion[3],
+                  2.0 * std::atan(0.5 * p.width / p.fx) * 180.0 / M_PI, p.fx);
+  }
+  return text;
+}
+
+}  // namespace
 
 VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : nh_(nh), pnh_(private_nh), it_(nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
+    : nh_(nh), pnh_(private_nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
   load_parameters();
   vo_ = std::make_unique<VisualOdometry>(vo_options_);
   queue_ = std::make_unique<FrameQueue<Frame>>(frame_queue_size_);
@@ -36,8 +65,9 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
   reset_service_ = pnh_.advertiseService("reset", &VoNode::reset_callback, this);
   watchdog_timer_ = nh_.createTimer(ros::Duration(0.5), &VoNode::watchdog, this);
   worker_ = std::thread(&VoNode::run, this);
-  ROS_INFO("hybrid_vo: %s, %s sync, preset %s, points %s, lines %s%s%s",
-           stereo_ ? "stereo" : "mono", approximate_sync_ ? "approximate" : "exact",
+  ROS_INFO("hybrid_vo: %s, %s images on %s, %s sync, preset %s, points %s, lines %s%s%s",
+           stereo_ ? "stereo" : "mono", compressed_ ? "compressed" : "raw", image_topic_.c_str(),
+           approximate_sync_ ? "approximate" : "exact",
            pnh_.param<std::string>("preset", "hybrid").c_str(),
            pnh_.param<std::string>("points", "klt").c_str(),
            vo_options_.use_lines ? pnh_.param<std::string>("lines", "fld").c_str() : "none",
@@ -55,6 +85,19 @@ void VoNode::load_parameters() {
   pnh_.param<std::string>("base_frame", base_frame_, "base_link");
   pnh_.param("stereo", stereo_, false);
   pnh_.param("approximate_sync", approximate_sync_, false);
+  pnh_.param("rectify_fisheye", rectify_fisheye_, true);
+  double fov_deg = pnh_.param("rectified_fov_deg", 100.0);
+  if (!(fov_deg >= 10.0 && fov_deg <= 170.0)) {
+    ROS_WARN("hybrid_vo: rectified_fov_deg must be in [10, 170], using 100");
+    fov_deg = 100.0;
+  }
+  left_rectifier_ = right_rectifier_ = FisheyeRectifier(fov_deg);
+  // As the standard image_transport parameter, but decoded here: Debian has no plugin for it.
+  const std::string transport = pnh_.param<std::string>("image_transport", "raw");
+  compressed_ = transport == "compressed";
+  if (transport != "raw" && transport != "compressed")
+    ROS_WARN("hybrid_vo: image_transport '%s' unknown (raw or compressed), using 'raw'",
+             transport.c_str());
   pnh_.param("queue_size", queue_size_, 10);
   pnh_.param("publish_tf", publish_tf_, true);
   pnh_.param("feature_points", use_feature_points_, false);
@@ -218,22 +261,53 @@ void VoNode::process(const Frame& frame) {
   latency_ms_.add(latency_ms);
 }
 
+bool VoNode::gray_of(const FrameImage& image, const CameraModel& camera, cv::Mat* gray,
+                     double* decode_ms, std::string* reason) const {
+  if (image.raw) return gray_from_image(image.raw, gray, reason);
+  const auto start = std::chrono::steady_clock::now();
+  const bool ok = gray_from_compressed(*image.compressed, camera.pinhole.width,
+                                       camera.pinhole.height, gray, reason);
+  *decode_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count();
+  return ok;
+}
+
+bool VoNode::rectify(const sensor_msgs::CameraInfo& info, FisheyeRectifier* rectifier,
+                     CameraModel* camera, cv::Mat* image, std::string* reason) {
+  if (camera->model != LensModel::kEquidistant || !rectify_fisheye_) return true;
+  Eigen::Matrix3d R;
+  if (!rectification_from_info(info, &R)) {
+    *reason = "R is not a rotation matrix";
+    return false;
+  }
+  cv::Mat rectified;
+  if (!rectifier->rectify(*camera, R, *image, &rectified, camera, reason)) return false;
+  *image = rectified;
+  return true;
+}
+
 bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
   input->stamp = frame.stamp.toSec();
   std::string reason;
+  double decode_ms = 0.0;
   if (!camera_from_info(*frame.left_info, &input->camera, &reason))
     return reject("camera_info", reason, &invalid_camera_info_);
-  if (!gray_from_image(frame.left, &input->image, &reason))
+  if (!gray_of(frame.left, input->camera, &input->image, &decode_ms, &reason))
     return reject("image", reason, &bad_images_);
-  if (static_cast<int>(frame.left->width) != input->camera.pinhole.width ||
-      static_cast<int>(frame.left->height) != input->camera.pinhole.height)
+  if (input->image.cols != input->camera.pinhole.width ||
+      input->image.rows != input->camera.pinhole.height)
     return reject("camera_info", "its size differs from the image's", &invalid_camera_info_);
+  const CameraModel lens = input->camera;
+  if (!rectify(*frame.left_info, &left_rectifier_, &input->camera, &input->image, &reason))
+    return reject("camera_info", reason, &invalid_camera_info_);
   if (stereo_) {
     CameraModel right;
     if (!camera_from_info(*frame.right_info, &right, &reason))
       return reject("right camera_info", reason, &invalid_camera_info_);
-    if (!gray_from_image(frame.right, &input->right_image, &reason))
+    if (!gray_of(frame.right, right, &input->right_image, &decode_ms, &reason))
       return reject("right image", reason, &bad_images_);
+    if (!rectify(*frame.right_info, &right_rectifier_, &right, &input->right_image, &reason))
+      return reject("right camera_info", reason, &invalid_camera_info_);
     if (!baseline_from_info(*frame.right_info, &input->baseline_m))
       return reject("right camera_info", "P has no baseline term (P[3] = -fx * B)",
                     &invalid_camera_info_);
@@ -250,6 +324,9 @@ bool VoNode::read_input(const Frame& frame, VisualOdometryInput* input) {
                                  : lines_from_msg(*frame.lines, &input->external, &reason);
     if (!ok) return reject("features/lines", reason, &bad_features_);
   }
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  if (compressed_) decode_ms_.add(decode_ms);
+  camera_model_ = describe_camera(*frame.left_info, lens, input->camera);
   return true;
 }
 

@@ -24,7 +24,7 @@ void VoNode::watchdog(const ros::TimerEvent&) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     images_flow =
-        !last_raw_image_.isZero() && (now - last_raw_image_).toSec() < camera_info_timeout_;
+        !last_image_.isZero() && (now - last_image_).toSec() < camera_info_timeout_;
     // A few images in a row, not one that is waiting for its camera_info after a pause.
     frames_flow = unsynced_images_ < 3 || (!last_synced_image_.isZero() &&
                                            (now - last_synced_image_).toSec() < camera_info_timeout_);
@@ -68,9 +68,21 @@ void VoNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
     summary = last_problem_;
   }
   status.summary(level, summary);
+  add_input(status);
   add_tracking(status);
   add_vp_tracks(status);
   add_counters(status);
+}
+
+void VoNode::add_input(diagnostic_updater::DiagnosticStatusWrapper& status) const {
+  status.add("image topic", image_topic_);
+  status.add("image transport", compressed_ ? "compressed (decoded by the node)" : "raw");
+  status.add("camera model", camera_model_.empty() ? "no frame yet" : camera_model_);
+  if (compressed_) {
+    // Per frame (both images in stereo), from the last 200 frames.
+    status.add("image decode p50 (ms)", decode_ms_.quantile(0.5));
+    status.add("image decode p99 (ms)", decode_ms_.quantile(0.99));
+  }
 }
 
 void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) const {
@@ -85,6 +97,12 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("line matches", r.num_line_matches);
   status.add("line inliers", est.num_line_inliers);
   status.add("VP inliers", est.num_vp_inliers);
+  status.add("junction inliers", est.num_junction_inliers);
+  // Orientation anchoring: how many VP tracks corrected this frame's orientation, by how much,
+  // and how many disagreed beyond the gate.
+  status.add("orientation anchors", r.anchoring.anchors);
+  status.add("orientation anchors rejected", r.anchoring.rejected);
+  status.add("orientation correction (deg)", r.anchoring.correction_deg);
   status.add("scale known", r.scale_known);
   if (r.stereo_scale_attempted) {
     status.add("stereo scale", to_string(r.stereo_scale.status));

@@ -1,6 +1,7 @@
 // The node's inputs: image and camera_info subscriptions (mono or stereo, exact or approximate
-// sync), the optional feature topics, and the assembly of frames from their parts. Callbacks
-// only assemble frames and queue the complete ones for the processing thread.
+// sync, raw or compressed images), the optional feature topics, and the assembly of frames from
+// their parts. Callbacks only assemble frames and queue the complete ones for the processing
+// thread, which decodes compressed images (vo_node.cc).
 #include "hybrid_vo/node/vo_node.h"
 
 namespace hybrid_vo {
@@ -11,32 +12,28 @@ void VoNode::subscribe() {
   // TCP_NODELAY: without it Nagle's algorithm holds a small camera_info (or the last segment of
   // an image) until the previous one is acknowledged, which adds up to 40 ms per frame.
   const ros::TransportHints no_delay = ros::TransportHints().tcpNoDelay();
-  const image_transport::TransportHints image_hints("raw", no_delay);
-  left_sub_.subscribe(it_, left, queue_size_, image_hints);
+  // The compressed topic is image_transport's: the resolved (remapped) image topic plus
+  // "/compressed".
+  const std::string suffix = compressed_ ? "/compressed" : "";
+  image_topic_ = nh_.resolveName(left) + suffix;
   left_info_sub_.subscribe(nh_, left_info, queue_size_, no_delay);
-  if (stereo_) {
-    right_sub_.subscribe(it_, "right/image", queue_size_, image_hints);
-    right_info_sub_.subscribe(nh_, "right/camera_info", queue_size_, no_delay);
-    if (approximate_sync_) {
-      approx_stereo_ = std::make_unique<message_filters::Synchronizer<ApproxStereo>>(
-          ApproxStereo(queue_size_), left_sub_, left_info_sub_, right_sub_, right_info_sub_);
-      approx_stereo_->registerCallback(&VoNode::stereo_callback, this);
-    } else {
-      exact_stereo_ = std::make_unique<message_filters::Synchronizer<ExactStereo>>(
-          ExactStereo(queue_size_), left_sub_, left_info_sub_, right_sub_, right_info_sub_);
-      exact_stereo_->registerCallback(&VoNode::stereo_callback, this);
-    }
-  } else if (approximate_sync_) {
-    approx_mono_ = std::make_unique<message_filters::Synchronizer<ApproxMono>>(
-        ApproxMono(queue_size_), left_sub_, left_info_sub_);
-    approx_mono_->registerCallback(&VoNode::mono_callback, this);
+  if (stereo_) right_info_sub_.subscribe(nh_, "right/camera_info", queue_size_, no_delay);
+  if (compressed_) {
+    left_compressed_sub_.subscribe(nh_, image_topic_, queue_size_, no_delay);
+    if (stereo_)
+      right_compressed_sub_.subscribe(nh_, nh_.resolveName("right/image") + suffix, queue_size_,
+                                      no_delay);
+    synchronise(&left_compressed_sub_, &right_compressed_sub_);
+    arrival_sub_ = nh_.subscribe(image_topic_, 1,
+                                 &VoNode::image_arrived<sensor_msgs::CompressedImage>, this,
+                                 no_delay);
   } else {
-    exact_mono_ = std::make_unique<message_filters::Synchronizer<ExactMono>>(
-        ExactMono(queue_size_), left_sub_, left_info_sub_);
-    exact_mono_->registerCallback(&VoNode::mono_callback, this);
+    left_sub_.subscribe(nh_, image_topic_, queue_size_, no_delay);
+    if (stereo_) right_sub_.subscribe(nh_, "right/image", queue_size_, no_delay);
+    synchronise(&left_sub_, &right_sub_);
+    arrival_sub_ =
+        nh_.subscribe(image_topic_, 1, &VoNode::image_arrived<sensor_msgs::Image>, this, no_delay);
   }
-  // A second, unsynchronised subscription tells "no images" from "images without camera_info".
-  raw_image_sub_ = nh_.subscribe(left, 1, &VoNode::raw_image_callback, this, no_delay);
   if (use_feature_points_) {
     points_sub_ = vins_format_ ? nh_.subscribe("features/points", queue_size_,
                                                &VoNode::vins_points_callback, this, no_delay)
@@ -51,9 +48,42 @@ void VoNode::subscribe() {
   }
 }
 
-void VoNode::raw_image_callback(const sensor_msgs::ImageConstPtr& image) {
+template <class ImageMsg>
+void VoNode::synchronise(message_filters::Subscriber<ImageMsg>* left,
+                         message_filters::Subscriber<ImageMsg>* right) {
+  namespace policies = message_filters::sync_policies;
+  using Info = sensor_msgs::CameraInfo;
+  if (stereo_ && approximate_sync_) {
+    using Policy = policies::ApproximateTime<ImageMsg, Info, ImageMsg, Info>;
+    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(
+        Policy(queue_size_), *left, left_info_sub_, *right, right_info_sub_);
+    sync->registerCallback(&VoNode::stereo_callback<ImageMsg>, this);
+    sync_ = sync;
+  } else if (stereo_) {
+    using Policy = policies::ExactTime<ImageMsg, Info, ImageMsg, Info>;
+    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(
+        Policy(queue_size_), *left, left_info_sub_, *right, right_info_sub_);
+    sync->registerCallback(&VoNode::stereo_callback<ImageMsg>, this);
+    sync_ = sync;
+  } else if (approximate_sync_) {
+    using Policy = policies::ApproximateTime<ImageMsg, Info>;
+    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(Policy(queue_size_),
+                                                                        *left, left_info_sub_);
+    sync->registerCallback(&VoNode::mono_callback<ImageMsg>, this);
+    sync_ = sync;
+  } else {
+    using Policy = policies::ExactTime<ImageMsg, Info>;
+    auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(Policy(queue_size_),
+                                                                        *left, left_info_sub_);
+    sync->registerCallback(&VoNode::mono_callback<ImageMsg>, this);
+    sync_ = sync;
+  }
+}
+
+template <class ImageMsg>
+void VoNode::image_arrived(const boost::shared_ptr<const ImageMsg>&) {
   std::lock_guard<std::mutex> lock(mutex_);
-  last_raw_image_ = ros::Time::now();
+  last_image_ = ros::Time::now();
   ++unsynced_images_;
 }
 
@@ -69,33 +99,34 @@ VoNode::Frame& VoNode::pending(const ros::Time& stamp) {
   return pending_[stamp];
 }
 
-void VoNode::mono_callback(const sensor_msgs::ImageConstPtr& image,
+template <class ImageMsg>
+void VoNode::mono_callback(const boost::shared_ptr<const ImageMsg>& image,
                            const sensor_msgs::CameraInfoConstPtr& info) {
-  add_images(image, info, nullptr, nullptr);
+  add_images(image->header, FrameImage(image), info, FrameImage(), nullptr);
 }
 
-void VoNode::stereo_callback(const sensor_msgs::ImageConstPtr& left,
+template <class ImageMsg>
+void VoNode::stereo_callback(const boost::shared_ptr<const ImageMsg>& left,
                              const sensor_msgs::CameraInfoConstPtr& left_info,
-                             const sensor_msgs::ImageConstPtr& right,
+                             const boost::shared_ptr<const ImageMsg>& right,
                              const sensor_msgs::CameraInfoConstPtr& right_info) {
-  add_images(left, left_info, right, right_info);
+  add_images(left->header, FrameImage(left), left_info, FrameImage(right), right_info);
 }
 
-void VoNode::add_images(const sensor_msgs::ImageConstPtr& left,
-                        const sensor_msgs::CameraInfoConstPtr& left_info,
-                        const sensor_msgs::ImageConstPtr& right,
+void VoNode::add_images(const std_msgs::Header& header, const FrameImage& left,
+                        const sensor_msgs::CameraInfoConstPtr& left_info, const FrameImage& right,
                         const sensor_msgs::CameraInfoConstPtr& right_info) {
   std::lock_guard<std::mutex> lock(mutex_);
   last_synced_image_ = ros::Time::now();
   unsynced_images_ = 0;
-  Frame& f = pending(left->header.stamp);
+  Frame& f = pending(header.stamp);
   f.left = left;
   f.left_info = left_info;
   f.right = right;
   f.right_info = right_info;
-  f.frame_id = left->header.frame_id;
+  f.frame_id = header.frame_id;
   f.have_images = true;
-  try_process(left->header.stamp);
+  try_process(header.stamp);
 }
 
 // A feature message is one part of its frame (DESIGN.md: stamped like its image).

@@ -114,7 +114,10 @@ void VoNode::publish_debug_image(const Frame& frame, const VisualOdometryInput& 
   for (const VpMatch& v : result.matches.vps) directions.push_back(v.d2);
   const cv::Mat canvas =
       draw_view(input.image, points, segments, labels, directions, input.camera.pinhole);
-  debug_image_pub_.publish(cv_bridge::CvImage(frame.left->header, "bgr8", canvas).toImageMsg());
+  std_msgs::Header header;
+  header.stamp = frame.stamp;
+  header.frame_id = frame.frame_id;
+  debug_image_pub_.publish(cv_bridge::CvImage(header, "bgr8", canvas).toImageMsg());
 }
 
 }  // namespace hybrid_vo

@@ -1,5 +1,8 @@
 #include "hybrid_vo/render/renderer.h"
 
+#include "fisheye_view.h"
+#include "shading.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -139,65 +142,33 @@ SampleGrid rasterize(const Scene& scene, const PinholeCamera& cam, const CameraP
   return grid;
 }
 
-float bilinear(const cv::Mat& m, double x, double y) {
-  x = std::clamp(x, 0.0, m.cols - 1.0);
-  y = std::clamp(y, 0.0, m.rows - 1.0);
-  const int x0 = std::min(static_cast<int>(x), m.cols - 2 < 0 ? 0 : m.cols - 2);
-  const int y0 = std::min(static_cast<int>(y), m.rows - 2 < 0 ? 0 : m.rows - 2);
-  const int x1 = std::min(x0 + 1, m.cols - 1), y1 = std::min(y0 + 1, m.rows - 1);
-  const double fx = x - x0, fy = y - y0;
-  if (m.type() == CV_8UC1) {
-    const uchar* r0 = m.ptr<uchar>(y0);
-    const uchar* r1 = m.ptr<uchar>(y1);
-    const double top = r0[x0] + fx * (r0[x1] - r0[x0]);
-    const double bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
-    return static_cast<float>(top + fy * (bottom - top));
-  }
-  const float* r0 = m.ptr<float>(y0);
-  const float* r1 = m.ptr<float>(y1);
-  const double top = r0[x0] + fx * (r0[x1] - r0[x0]);
-  const double bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
-  return static_cast<float>(top + fy * (bottom - top));
-}
-
-// Texture lookup at level-0 texel coordinates (tu, tv), texel c covering [c, c + 1); (du, dv)
-// per sample step along the image x and y axes give the footprint.
-double sample_texture(const Texture& tex, double tu, double tv, double dux, double dvx, double duy,
-                      double dvy, int max_anisotropy) {
-  const double lx = std::hypot(dux, dvx), ly = std::hypot(duy, dvy);
-  const bool x_major = lx >= ly;
-  const double major = x_major ? lx : ly, minor = std::max(x_major ? ly : lx, 1e-9);
-  const double au = x_major ? dux : duy, av = x_major ? dvx : dvy;
-  const int taps = std::clamp(static_cast<int>(std::ceil(major / minor - 1e-6)), 1, max_anisotropy);
-  const double footprint = std::max(minor, major / taps);
-  const int top_level = static_cast<int>(tex.levels.size()) - 1;
-  const double lod =
-      std::clamp(std::log2(std::max(footprint, 1e-9)), 0.0, static_cast<double>(top_level));
-  const int l0 = std::min(static_cast<int>(lod), top_level);
-  const int l1 = std::min(l0 + 1, top_level);
-  const double f = lod - l0;
-  const double s0 = 1.0 / (1 << l0), s1 = 1.0 / (1 << l1);
-  double sum = 0.0;
-  for (int k = 0; k < taps; ++k) {
-    const double o = (k + 0.5) / taps - 0.5;
-    const double u = tu + o * au, v = tv + o * av;
-    double value = bilinear(tex.levels[l0], u * s0 - 0.5, v * s0 - 0.5);
-    if (f > 1e-3 && l1 != l0)
-      value += f * (bilinear(tex.levels[l1], u * s1 - 0.5, v * s1 - 0.5) - value);
-    sum += value;
-  }
-  return sum / taps;
-}
-
-void check(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("render: " + what);
-}
-
 }  // namespace
 
 PinholeCamera default_camera(int width, int height) {
   const double f = 0.72 * width;
   return PinholeCamera(f, f, 0.5 * (width - 1), 0.5 * (height - 1), width, height);
+}
+
+RenderedView render_view(const Scene& scene, const CameraModel& camera, const CameraPose& pose,
+                         const RenderOptions& options) {
+  if (camera.model == LensModel::kEquidistant)
+    return render_equidistant_view(scene, camera, pose, options);
+  check(!camera.has_distortion(), "only pinhole and equidistant cameras are rendered");
+  return render_view(scene, camera.pinhole, pose, options);
+}
+
+CameraModel fisheye_camera(double fov_deg, int width, int height) {
+  check(fov_deg > 0.0 && fov_deg < 220.0, "the fisheye's field of view must be in (0, 220)");
+  CameraModel c;
+  c.model = LensModel::kEquidistant;
+  c.distortion = {-0.02, 0.003, -0.0005, 0.0001, 0.0};
+  const double half = 0.5 * fov_deg * M_PI / 180.0, h2 = half * half;
+  const double theta_d =
+      half * (1.0 + h2 * (c.distortion[0] + h2 * (c.distortion[1] +
+                                                  h2 * (c.distortion[2] + h2 * c.distortion[3]))));
+  const double f = 0.5 * width / theta_d;
+  c.pinhole = PinholeCamera(f, f, 0.5 * (width - 1), 0.5 * (height - 1), width, height);
+  return c;
 }
 
 int cast_ray(const Scene& scene, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
@@ -223,19 +194,7 @@ RenderedView render_view(const Scene& scene, const PinholeCamera& cam, const Cam
                          const RenderOptions& o) {
   check(cam.valid() && cam.width >= 1 && cam.height >= 1 && cam.width <= 8192 && cam.height <= 8192,
         "the camera needs valid intrinsics and a size in [1, 8192]");
-  check(o.supersampling >= 1 && o.supersampling <= 8, "supersampling must be in [1, 8]");
-  check(std::isfinite(o.blur_sigma) && o.blur_sigma >= 0.0 && o.blur_sigma <= 10.0,
-        "blur_sigma must be in [0, 10]");
-  check(std::isfinite(o.noise_sigma) && o.noise_sigma >= 0.0 && o.noise_sigma <= 100.0,
-        "noise_sigma must be in [0, 100]");
-  check(o.max_anisotropy >= 1 && o.max_anisotropy <= 16, "max_anisotropy must be in [1, 16]");
-  check(std::isfinite(o.exposure) && o.exposure > 0.0, "exposure must be positive");
-  check(std::isfinite(o.near) && o.near > 0.0, "near must be positive");
-  check(pose.R_world_from_camera.allFinite() && pose.centre.allFinite() &&
-            (pose.R_world_from_camera.transpose() * pose.R_world_from_camera -
-             Eigen::Matrix3d::Identity())
-                    .norm() < 1e-6,
-        "the pose needs a finite rotation matrix and centre");
+  check_render_inputs(o, pose);
 
   const int ss = o.supersampling;
   const SampleGrid grid = rasterize(scene, cam, pose, ss, o.near);
@@ -269,14 +228,7 @@ RenderedView render_view(const Scene& scene, const PinholeCamera& cam, const Cam
               const double nd = q.normal.dot(d);
               const Eigen::Vector3d dX_dx = t * (ex - d * (q.normal.dot(ex) / nd));
               const Eigen::Vector3d dX_dy = t * (ey - d * (q.normal.dot(ey) / nd));
-              const double tpm = q.texture.texels_per_metre;
-              const double albedo =
-                  sample_texture(q.texture, uv.x() * tpm, uv.y() * tpm, dX_dx.dot(q.u_axis) * tpm,
-                                 dX_dx.dot(q.v_axis) * tpm, dX_dy.dot(q.u_axis) * tpm,
-                                 dX_dy.dot(q.v_axis) * tpm, o.max_anisotropy);
-              const double lpm = q.lightmap_per_metre;
-              const double light = bilinear(q.lightmap, uv.x() * lpm - 0.5, uv.y() * lpm - 0.5);
-              sum += albedo * light;
+              sum += shade(q, uv, dX_dx, dX_dy, o.max_anisotropy);
             }
           }
           out[x] = static_cast<float>(o.exposure * sum / (ss * ss));
@@ -285,17 +237,8 @@ RenderedView render_view(const Scene& scene, const PinholeCamera& cam, const Cam
     }
   });
 
-  if (o.blur_sigma > 0.0)
-    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), o.blur_sigma, o.blur_sigma,
-                     cv::BORDER_REFLECT);
-  if (o.noise_sigma > 0.0) {
-    cv::Mat noise(radiance.size(), CV_32FC1);
-    cv::RNG rng(o.noise_seed * 0x9E3779B97F4A7C15ull + 1);
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
-    radiance += noise;
-  }
   RenderedView view;
-  radiance.convertTo(view.image, CV_8U);
+  view.image = finish(radiance, o);
 
   // Depth and quad at the pixel centres: the middle sample for odd ss, else one more pass.
   const SampleGrid centres = ss % 2 == 1 ? SampleGrid() : rasterize(scene, cam, pose, 1, o.near);

@@ -64,9 +64,13 @@ std::string sequence_usage(const std::string& program) {
     << "  --baseline M       stereo baseline in metres (default 0.12)\n"
     << "  --speed M_PER_S    walking speed (default 1.5)\n"
     << "  --focal PX         focal length (default 0.72 * width)\n"
+    << "  --fisheye-fov DEG  an equidistant (fisheye) lens of this horizontal field of view\n"
+    << "                     instead of the pinhole (camera_info distortion_model equidistant)\n"
     << "  --noise SIGMA      image noise in grey levels (default 1)\n"
     << "  --supersampling K  K x K rays per pixel (default 3)\n"
     << "  --compression none|lz4|bz2  bag compression (default lz4)\n"
+    << "  --compressed png|jpeg  images as sensor_msgs/CompressedImage on .../image_raw/compressed\n"
+    << "  --jpeg-quality Q   with --compressed jpeg: quality 1..100 (default 95)\n"
     << "  --png-dir DIR      also write the images as PNG files\n"
     << "  --kitti-dir DIR    also write DIR/sequences/NAME/{image_0,image_1,calib.txt,times.txt}\n"
     << "                     and DIR/poses/NAME.txt (left camera-to-world in the scene's world)\n"
@@ -89,7 +93,8 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
                                     "--height",        "--rate",       "--seed",   "--scene",
                                     "--baseline",      "--speed",      "--focal",  "--noise",
                                     "--supersampling", "--compression", "--laps",
-                                    "--texture",       "--kitti-dir",   "--kitti-name"};
+                                    "--texture",       "--kitti-dir",   "--kitti-name",
+                                    "--compressed",    "--jpeg-quality", "--fisheye-fov"};
     bool known = false;
     for (const char* name : kValued) known = known || arg == name;
     if (!known) return "unknown argument '" + arg + "'";
@@ -137,11 +142,22 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     } else if (arg == "--compression") {
       o->compression = v;
       ok = v == "none" || v == "lz4" || v == "bz2";
+    } else if (arg == "--compressed") {
+      o->compressed_images = v;
+      ok = v == "png" || v == "jpeg";
+    } else if (arg == "--fisheye-fov") {
+      ok = parse_double(v, 0.0, 200.0, true, &o->fisheye_fov);
+    } else if (arg == "--jpeg-quality") {
+      ok = parse_int(v, 1, 100, &o->jpeg_quality);
     }
     if (!ok) return "bad value '" + v + "' for " + arg;
   }
   if (o->out_bag.empty() && o->kitti_dir.empty())
     return "--out OUT.bag or --kitti-dir DIR is required";
+  if (o->focal > 0.0 && o->fisheye_fov > 0.0)
+    return "--focal and --fisheye-fov exclude each other (the field of view sets the focal)";
+  if (!o->kitti_dir.empty() && o->fisheye_fov > 0.0)
+    return "--kitti-dir writes a pinhole calib.txt: not with --fisheye-fov";
   return "";
 }
 
@@ -186,6 +202,11 @@ Sequence make_sequence(const SequenceOptions& options) {
   seq.trajectory = make_trajectory(seq.scene, path);
   seq.camera = default_camera(options.width, options.height);
   if (options.focal > 0.0) seq.camera.fx = seq.camera.fy = options.focal;
+  seq.lens.pinhole = seq.camera;
+  if (options.fisheye_fov > 0.0) {
+    seq.lens = fisheye_camera(options.fisheye_fov, options.width, options.height);
+    seq.camera = seq.lens.pinhole;
+  }
   seq.render.supersampling = options.supersampling;
   seq.render.noise_sigma = options.noise;
   if (options.stereo && !(options.baseline > 0.0))
@@ -204,7 +225,7 @@ RenderedView render_frame(const Sequence& seq, int frame, bool right) {
   RenderOptions render = seq.render;
   render.noise_seed =
       hash_mix(seq.options.seed, 2 * static_cast<uint64_t>(frame) + (right ? 1 : 0));
-  return render_view(seq.scene, seq.camera, frame_pose(seq, frame, right), render);
+  return render_view(seq.scene, seq.lens, frame_pose(seq, frame, right), render);
 }
 
 }  // namespace render

@@ -39,14 +39,14 @@ void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
-               " [--search-leaving] [--no-anchor] [--no-vp-tracker] [--seed S] [--opencv-threads N]"
+               " [--drop-leaving] [--no-anchor] [--no-vp-tracker] [--seed S] [--opencv-threads N]"
                " [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
-               "  the KLT corners' strength floor (0: every corner); --search-leaving: KLT searches\n"
-               "  the features predicted outside the image too; --no-anchor: no orientation\n"
+               "  the KLT corners' strength floor (0: every corner); --drop-leaving: KLT drops\n"
+               "  the features predicted outside the image unsearched; --no-anchor: no orientation\n"
                "  anchoring by the VP tracks. Default preset hybrid+junc.\n"
                "  --opencv-threads N: OpenCV's own thread pool (cv::setNumThreads), as the node's\n"
                "  opencv_threads parameter; default 1 (none: the front end splits its work over\n"
@@ -155,7 +155,7 @@ int run(int argc, char** argv) {
     else if (a == "--min-corner-gradient" && i + 1 < argc)
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--no-predict") o.klt.predict_motion = false;
-    else if (a == "--search-leaving") o.klt.drop_leaving = false;
+    else if (a == "--drop-leaving") o.klt.drop_leaving = true;
     else if (a == "--stereo") stereo = true;
     else if (a == "--klt-window" && i + 1 < argc) o.klt.window_px = std::atoi(argv[++i]);
     else if (a == "--klt-iterations" && i + 1 < argc) o.klt.max_iterations = std::atoi(argv[++i]);
@@ -163,6 +163,7 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--no-anchor") o.anchor_orientation = false;
+    else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
     else if (a == "--direct-gap" && i + 1 < argc) {
@@ -322,9 +323,13 @@ int run(int argc, char** argv) {
     if (verbose) {
       // Per frame: status, VPs and what became of their priors, and the tracks.
       const RelativePoseEstimate& est = r.estimate.estimate;
-      std::printf("frame %d: %s, %d VPs (%d inliers), scales: point %.3f px, line %.3f px, VP "
+      std::printf("frame %d: %s, best %s, %d points (%d inliers), %d lines, %d junctions (%d "
+                  "inliers), %d VPs (%d inliers), scales: point %.3f px, line %.3f px, VP "
                   "%.4f deg (%d)",
-                  i, to_string(r.status), static_cast<int>(r.matches.vps.size()),
+                  i, to_string(r.status), solver_table()[static_cast<int>(est.best_solver)].code,
+                  r.num_point_matches, est.num_point_inliers, r.num_line_matches,
+                  static_cast<int>(est.junctions.size()), est.num_junction_inliers,
+                  static_cast<int>(r.matches.vps.size()),
                   est.num_vp_inliers, est.scales.point_px, est.scales.line_vp_px,
                   est.scales.vp_deg, est.scales.num_vps);
       for (size_t k = 0; k < est.vp_prior_chi2.size(); ++k)

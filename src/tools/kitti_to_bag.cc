@@ -26,8 +26,9 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << error << "\n";
     return 1;
   }
-  std::printf("converted %d frames (%s, %dx%d), %s -> %s\n", summary.frames,
+  std::printf("converted %d frames (%s, %dx%d, %s images), %s -> %s\n", summary.frames,
               options.stereo ? "stereo" : "mono", summary.width, summary.height,
+              to_string(options.images.kind),
               summary.poses_path.empty() ? "no ground truth"
                                          : ("ground truth from " + summary.poses_path).c_str(),
               options.out_bag.c_str());

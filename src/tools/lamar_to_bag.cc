@@ -27,13 +27,15 @@ int main(int argc, char** argv) {
     return 1;
   }
   for (size_t k = 0; k < summary.streams.size(); ++k)
-    std::printf("%s: %d images on %s/image_raw\n", summary.streams[k].c_str(), summary.images[k],
-                summary.topics[k].c_str());
+    std::printf("%s: %d images on %s/image_raw%s\n", summary.streams[k].c_str(),
+                summary.images[k], summary.topics[k].c_str(),
+                options.images.kind == BagImageFormat::kRaw ? "" : "/compressed");
   std::printf("%d ground-truth poses of %s%s%s; time offset %.0f s -> %s\n", summary.ground_truth,
               summary.streams[0].c_str(), summary.poses_path.empty() ? "" : " from ",
               summary.poses_path.c_str(), summary.time_offset, options.out_bag.c_str());
   // The launch file's camera argument is the topic name under /camera/.
-  std::printf("replay: roslaunch hybrid_vo lamar.launch bag:=%s camera:=%s\n",
-              options.out_bag.c_str(), summary.topics[0].substr(8).c_str());
+  std::printf("replay: roslaunch hybrid_vo lamar.launch bag:=%s camera:=%s%s\n",
+              options.out_bag.c_str(), summary.topics[0].substr(8).c_str(),
+              options.images.kind == BagImageFormat::kRaw ? "" : " image_transport:=compressed");
   return 0;
 }

@@ -2,6 +2,7 @@
 // bag with images, camera_info, ground-truth poses and tf (the demo's default data and the
 // rostest fixture), and/or into the KITTI odometry layout (the ROS-free tools' input).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -78,6 +79,11 @@ int main(int argc, char** argv) {
       std::cerr << "error: " << kitti_error << "\n";
       return 1;
     }
+    conversion::BagImageFormat image_format;
+    if (!options.compressed_images.empty())
+      conversion::parse_compressed_images(options.compressed_images, &image_format);  // checked
+    image_format.jpeg_quality = options.jpeg_quality;
+    out.set_image_format(image_format);
     const std::string left = conversion::optical_frame("left");
     const std::string right = conversion::optical_frame("right");
 
@@ -110,9 +116,14 @@ int main(int argc, char** argv) {
         const std::string& frame = is_right ? right : left;
         if (to_bag) {
           out.write_image(prefix + "/image_raw", frame, t, view.image);
-          out.bag().write(
-              prefix + "/camera_info", t,
-              conversion::make_camera_info(seq.camera, frame, t, is_right ? tx_right : 0.0));
+          out.bag().write(prefix + "/camera_info", t,
+                          seq.lens.model == hybrid_vo::LensModel::kEquidistant
+                              ? conversion::make_camera_info(
+                                    seq.camera, frame, t, is_right ? tx_right : 0.0,
+                                    "equidistant",
+                                    {seq.lens.distortion.begin(), seq.lens.distortion.begin() + 4})
+                              : conversion::make_camera_info(seq.camera, frame, t,
+                                                             is_right ? tx_right : 0.0));
         }
         if (!options.png_dir.empty()) {
           char name[64];
@@ -153,9 +164,13 @@ int main(int argc, char** argv) {
       outputs += (to_bag ? " and " : "") + kitti.sequence_dir() + " (poses " + kitti.poses_path() +
                  ")";
     std::printf(
-        "rendered %d frames (%s, %dx%d, %s, %s, %.0f Hz), path %.1f m, turned %.0f deg, "
+        "rendered %d frames (%s, %dx%d, %s%s, %s, %.0f Hz), path %.1f m, turned %.0f deg, "
         "%.3f s per view, %.1f s total -> %s\n",
         seq.options.frames, options.stereo ? "stereo" : "mono", options.width, options.height,
+        options.fisheye_fov > 0.0
+            ? (std::to_string(static_cast<int>(std::lround(options.fisheye_fov))) +
+               " deg equidistant, ").c_str()
+            : "",
         to_string(options.scene), to_string(options.texture), options.rate,
         seq.trajectory.length, seq.trajectory.total_turn_deg, render_seconds / views, total,
         outputs.c_str());

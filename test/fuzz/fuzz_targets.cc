@@ -16,13 +16,16 @@
 #include <boost/make_shared.hpp>
 #include <hybrid_vo/FeatureLines.h>
 #include <hybrid_vo/FeaturePoints.h>
+#include <opencv2/imgcodecs.hpp>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud.h>
 
 #include "hybrid_vo/datasets/kitti.h"
 #include "hybrid_vo/datasets/lamar.h"
 #include "hybrid_vo/datasets/readers.h"
+#include "hybrid_vo/node/compressed_image.h"
 #include "hybrid_vo/node/conversions.h"
 
 namespace hybrid_vo {
@@ -481,6 +484,27 @@ Outcome image(const uint8_t* data, size_t size) {
   return o;
 }
 
+// A CompressedImage: its format (one of the usual ones, or arbitrary text), the size its
+// camera_info gives, then the payload.
+Outcome compressed_image(const uint8_t* data, size_t size) {
+  ByteReader r(data, size);
+  static const char* kFormats[] = {"mono8; png compressed ", "mono8; jpeg compressed mono8",
+                                   "bgr8; jpeg compressed bgr8", "png", "jpeg", "",
+                                   "16UC1; compressedDepth png"};
+  sensor_msgs::CompressedImage image;
+  const uint8_t pick = r.u8();
+  image.format = pick < 2 * std::size(kFormats) ? kFormats[pick % std::size(kFormats)] : r.text(30);
+  const int width = r.value<uint16_t>(), height = r.value<uint16_t>();
+  const std::string payload = r.rest();
+  image.data.assign(payload.begin(), payload.end());
+  cv::Mat gray;
+  std::string error;
+  Outcome o = message_outcome(gray_from_compressed(image, width, height, &gray, &error), error);
+  expect(&o, gray.type() == CV_8UC1 && gray.cols == width && gray.rows == height,
+         "the grey image is not 8-bit of the camera_info's size");
+  return o;
+}
+
 // ------------------------------------------------------------------------------------------------
 // Seeds
 
@@ -651,6 +675,21 @@ std::vector<std::string> image_seeds() {
           image(5, 2, 1, 8, 8)};
 }
 
+std::vector<std::string> compressed_image_seeds() {
+  cv::Mat image(6, 8, CV_8UC1);
+  for (int k = 0; k < 48; ++k) image.data[k] = static_cast<uint8_t>(k * 37);
+  cv::Mat wide;
+  image.convertTo(wide, CV_16U, 257.0);
+  auto seed = [&](uint8_t format, const std::string& ext, const cv::Mat& pixels) {
+    std::vector<uint8_t> bytes;
+    cv::imencode(ext, pixels, bytes);
+    ByteWriter b;
+    b.u8(format).value(static_cast<uint16_t>(pixels.cols)).value(static_cast<uint16_t>(pixels.rows));
+    return b.bytes() + std::string(bytes.begin(), bytes.end());
+  };
+  return {seed(0, ".png", image), seed(1, ".jpg", image), seed(3, ".png", wide)};
+}
+
 }  // namespace
 
 const std::vector<Target>& targets() {
@@ -668,6 +707,7 @@ const std::vector<Target>& targets() {
       {"vins_lines", vins_lines, vins_lines_seeds, false},
       {"camera_info", camera_info, camera_info_seeds, false},
       {"image", image, image_seeds, false},
+      {"compressed_image", compressed_image, compressed_image_seeds, false},
   };
   return all;
 }

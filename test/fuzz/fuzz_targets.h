@@ -2,7 +2,8 @@
 
 // Fuzz targets of every reader of outside input: the data set parsers (KITTI calib/times/poses,
 // TUM, Strecha, SuperGlue pairs, LaMAR sessions, all from files) and the node's message
-// conversions (FeaturePoints, FeatureLines, VINS PointCloud points and lines, CameraInfo, Image).
+// conversions (FeaturePoints, FeatureLines, VINS PointCloud points and lines, CameraInfo, Image,
+// CompressedImage).
 // One input runs one target; the outcome says whether the input was accepted, the error it was
 // rejected with, and any broken promise ("violation"): a rejection without a clear error (for
 // files: "path[:line]: message" naming the file), or an accepted result with a non-finite value,

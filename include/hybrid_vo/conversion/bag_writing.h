@@ -6,7 +6,9 @@
 // damaged one stops the conversion instead of going into the bag.
 //
 // Layout of a bag (the launch files rely on it):
-//   /camera/<name>/image_raw     sensor_msgs/Image mono8, frame camera_<name>_optical
+//   /camera/<name>/image_raw     sensor_msgs/Image mono8, frame camera_<name>_optical; or, with
+//                                compressed images (BagImageFormat), /camera/<name>/image_raw/
+//                                compressed, sensor_msgs/CompressedImage PNG or JPEG
 //   /camera/<name>/camera_info   sensor_msgs/CameraInfo of the same stamp and frame
 //   /tf_static                   base_link -> camera_<name>_optical (REP 103 body, z-forward
 //                                optical frame), latched
@@ -54,6 +56,19 @@ sensor_msgs::CameraInfo make_camera_info(const PinholeCamera& camera, const std:
                                          const std::string& distortion_model = "plumb_bob",
                                          const std::vector<double>& D = {0, 0, 0, 0, 0});
 
+// How a bag holds its images: raw, or compressed as compressed_image_transport publishes them
+// and robots record them: sensor_msgs/CompressedImage on <image topic>/compressed with the
+// format "mono8; png compressed " or "mono8; jpeg compressed mono8".
+struct BagImageFormat {
+  enum Kind { kRaw, kPng, kJpeg } kind = kRaw;
+  int jpeg_quality = 95;  // 1..100
+};
+// The value of a converter's --compressed: "png" or "jpeg". False for anything else.
+bool parse_compressed_images(const std::string& value, BagImageFormat* format);
+// The value of --jpeg-quality: an integer in 1..100.
+bool parse_jpeg_quality(const std::string& value, BagImageFormat* format);
+const char* to_string(BagImageFormat::Kind kind);
+
 // A bag written to OUT.tmp and renamed to OUT by commit(), so that a failed conversion never
 // leaves a bag that looks complete; an uncommitted file is deleted by the destructor.
 class BagOutput {
@@ -69,6 +84,10 @@ class BagOutput {
   bool commit(std::string* error);
   rosbag::Bag& bag() { return bag_; }
 
+  // Raw by default.
+  void set_image_format(const BagImageFormat& format) { image_format_ = format; }
+  // An image on `topic` (raw), or compressed on `topic`/compressed; throws std::runtime_error
+  // when the encoder fails.
   void write_image(const std::string& topic, const std::string& frame, const ros::Time& stamp,
                    const cv::Mat& mono8);
   // The camera-to-world pose (R, centre) on /ground_truth/pose and as world -> child on /tf.
@@ -82,6 +101,7 @@ class BagOutput {
 
  private:
   rosbag::Bag bag_;
+  BagImageFormat image_format_;
   std::string path_, tmp_path_;
   bool committed_ = false;
 };
@@ -94,11 +114,6 @@ class BagOutput {
 // turned grey by the decoder); *channels is 1 for a grey file and 3 for a colour one, so that a
 // converter can refuse a frame unlike the rest of its stream.
 bool read_mono8(const std::string& path, cv::Mat* mono8, int* channels, std::string* error);
-
-// True when JPEG bytes reach their end-of-image marker (bytes after it are allowed): marker
-// segments are skipped by their length, entropy-coded data up to the next marker that is neither
-// a stuffed 0xFF00 nor a restart marker.
-bool jpeg_reaches_end(const std::vector<unsigned char>& bytes);
 
 }  // namespace conversion
 }  // namespace hybrid_vo

@@ -2,7 +2,8 @@
 
 // A KITTI odometry sequence to a bag in our layout (bag_writing.h), the library behind
 // hybrid_vo_kitti_to_bag:
-//   /camera/left/{image_raw,camera_info}   image_0, K and P from P0 (mono8, rectified: D = 0)
+//   /camera/left/{image_raw,camera_info}   image_0, K and P from P0 (mono8, rectified: D = 0);
+//                                          with --compressed, image_raw/compressed instead
 //   /camera/right/{image_raw,camera_info}  with --stereo: image_1, P1 with P(0,3) = -fx * b
 //   /tf_static    base_link -> camera_left_optical (and camera_right_optical, b along optical x)
 //   /ground_truth/pose, /tf world -> gt_camera_left_optical   when poses exist
@@ -10,6 +11,8 @@
 
 #include <string>
 #include <vector>
+
+#include "hybrid_vo/conversion/bag_writing.h"
 
 namespace hybrid_vo {
 namespace conversion {
@@ -22,6 +25,7 @@ struct KittiBagOptions {
   // Seconds added to times.txt (which starts at 0): ros::Time 0 is not a valid bag time. 1 s is
   // also where hybrid_vo_render_sequence starts.
   double start_time = 1.0;
+  BagImageFormat images;  // raw, or compressed PNG or JPEG (--compressed, --jpeg-quality)
   bool help = false;
 };
 

@@ -3,7 +3,8 @@
 // A LaMAR Capture session (datasets/lamar.h) to a bag in our layout (bag_writing.h), the library
 // behind hybrid_vo_lamar_to_bag. Per selected camera stream <name> (the sensor id made a valid
 // ROS name, see sanitize_name; a phone's per-frame cameras form one stream):
-//   /camera/<name>/image_raw     mono8 (colour images are converted to grey)
+//   /camera/<name>/image_raw     mono8 (colour images are converted to grey); with --compressed,
+//                                image_raw/compressed instead
 //   /camera/<name>/camera_info   that image's own camera: K with the principal point moved to
 //                                ROS's pixel convention, D per model (OPENCV: plumb_bob
 //                                [k1 k2 p1 p2 0]), R = I, P = [K | 0]
@@ -19,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "hybrid_vo/conversion/bag_writing.h"
+
 namespace hybrid_vo {
 namespace conversion {
 
@@ -29,6 +32,7 @@ struct LamarBagOptions {
   // Seconds added to every stamp; < 0: 1 s when the first image's timestamp is below 1 s (a
   // 0-based session; ros::Time 0 is not a valid bag time), else 0.
   double time_offset = -1.0;
+  BagImageFormat images;  // raw, or compressed PNG or JPEG (--compressed, --jpeg-quality)
   bool help = false;
 };
 

@@ -43,10 +43,12 @@ struct KltTrackerOptions {
   // does not start the short search at half the true motion (up to kMaxMotionScale).
   bool predict_motion = true;
   int predicted_pyramid_levels = 1;
-  // A feature predicted to lie outside the image has left it: it is dropped without a search. On
-  // KITTI 130 features a frame are, and a long search each found 4 of them inside again, for 8 %
-  // of the front end's instructions (same AUC and drift: README, "Throughput").
-  bool drop_leaving = true;
+  // Whether a feature predicted to lie outside the image is dropped without a search. On KITTI
+  // 130 features a frame are, and searching them costs 8 % of the front end's instructions for
+  // the same accuracy; but where the prediction overshoots (a corridor's turns) the search finds
+  // them inside again, and dropping them costs accuracy (rendered corridors 1.3-1.7 -> 1.6-2.2
+  // deg/100 m; doc/performance.md). So off by default.
+  bool drop_leaving = false;
 };
 
 // Re-detection's work, cell by cell (KltTracker::plan_detection, detect_cell, add_detections).

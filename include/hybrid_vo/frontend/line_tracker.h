@@ -9,10 +9,11 @@
 namespace hybrid_vo {
 
 // Segment tracking in video by the segments' own geometry (issue 30): each track is predicted
-// from its own last image motion, searched for among the frame's detected segments near that
-// prediction, and keeps a stable id, as KLT does for points. Nothing depends on point flow, so
-// segments track where points cannot (white walls). The LBD descriptor only tells apart several
-// candidates near one prediction.
+// by the camera's expected rotation (an image homography, K R K^-1, from the last motion) and
+// its own last image motion beyond that, searched for among the frame's detected segments near
+// the prediction, and keeps a stable id, as KLT does for points. Nothing depends on point flow,
+// so segments track where points cannot (white walls), and through fast turns. The LBD
+// descriptor only tells apart several candidates near one prediction.
 struct LineTrackerOptions {
   // A detected segment is a candidate for a track when its direction, oriented by the gradient
   // (line_matching.h, so an edge of the opposite contrast never is), lies within max_angle_deg of
@@ -33,12 +34,20 @@ struct LineTrackerOptions {
   // A track not found this many frames in a row is dropped; until then it coasts on its
   // prediction, so a segment that the detector misses once keeps its id.
   int max_missed_frames = 2;
+  // Re-identification: when the search loses at least reidentify_min_lost tracks and
+  // reidentify_min_fraction of them (a turn starting, a jolt: the prediction is off), the lost
+  // ones are matched by their LBD descriptors (match_line_features, with its geometric filter)
+  // to the segments the search left over.
+  bool reidentify = true;
+  int reidentify_min_lost = 3;
+  double reidentify_min_fraction = 0.2;
 };
 
 struct LineTrackingStats {
   int tracks = 0;     // tracks before this frame
   int matched = 0;    // found in this frame
   int ambiguous = 0;  // of those, told apart by the descriptor
+  int reidentified = 0;  // of those, found by descriptor matching after the search
   int started = 0;    // new tracks from this frame's unmatched segments
   int dropped = 0;    // tracks missed for more than max_missed_frames
 };
@@ -46,34 +55,42 @@ struct LineTrackingStats {
 class LineTracker {
  public:
   static constexpr double kNoStamp = std::numeric_limits<double>::quiet_NaN();
-  explicit LineTracker(const LineTrackerOptions& options = {});
+  // `matching` is what the descriptors were computed with (detect_line_features) and what
+  // re-identification matches by.
+  explicit LineTracker(const LineTrackerOptions& options = {},
+                       const LineMatchingOptions& matching = video_line_matching_options());
 
   // Tracks into this frame's segments (described and oriented, as detect_line_features gives
   // them; descriptors optional) and starts tracks for the unmatched ones. Returns the track id
   // of every segment of `current`, in order. `stamp` (seconds) scales the constant-velocity
-  // prediction when frames are not evenly spaced.
+  // prediction when frames are not evenly spaced. `image_motion` maps the last frame's pixels to
+  // this frame's as the camera's rotation alone would (K R K^-1; identity when unknown); each
+  // track's own motion is what remains beyond it. A homography that is not finite or not
+  // invertible counts as identity.
   std::vector<int64_t> track(const LineFeatures& current, double stamp = kNoStamp,
-                             LineTrackingStats* stats = nullptr);
+                             LineTrackingStats* stats = nullptr,
+                             const Eigen::Matrix3d& image_motion = Eigen::Matrix3d::Identity());
   void reset();
   int num_tracks() const { return static_cast<int>(tracks_.size()); }
 
  private:
   struct Track {
     int64_t id = 0;
-    LineSegment segment;  // where it was last seen (oriented)
-    cv::Mat descriptor;   // its LBD row then, or empty
-    double seen_at = 0.0;
-    // Image motion per unit of time: the shift of the line along its normal at the midpoint and
-    // the turn of its direction; unknown until seen twice.
+    LineSegment segment;  // where it was last seen (oriented), or predicted while it coasts
+    cv::Mat descriptor;   // its LBD row when last seen, or empty
+    double seen_at = 0.0;  // the time of `segment`
+    // Image motion per unit of time beyond the camera's rotation: the shift of the line along its
+    // normal at the midpoint and the turn of its direction; unknown until seen twice.
     bool has_motion = false;
     Eigen::Vector2d shift = Eigen::Vector2d::Zero();
     double turn = 0.0;
     int missed = 0;  // frames in a row without a match
   };
-  // Where track t lies at time `now`.
-  static LineSegment predict(const Track& t, double now);
+  // Where track t lies at time `now`, its segment first carried by `image_motion`.
+  static LineSegment predict(const Track& t, double now, const Eigen::Matrix3d& image_motion);
 
   LineTrackerOptions options_;
+  LineMatchingOptions matching_;
   std::vector<Track> tracks_;
   int64_t next_id_ = 0;
   // The tracker's clock: the frames' stamps, or one unit per frame without them.

@@ -61,12 +61,11 @@ struct VisualOdometryOptions {
   VpTrackerOptions vp_tracker;
   // Orientation anchoring (VpTracker::anchor): each frame's orientation, predicted by the pair's
   // rotation, is corrected by the confident VP tracks it sees. The prediction's uncertainty grows
-  // per pair by the estimator's rotation covariance, times rotation_covariance_scale, plus
-  // rotation_drift_floor_deg per axis. The estimator's covariance tells a pair whose points
-  // barely separate rotation from translation (white panels seen from 2 m: 0.08 deg) from a well
-  // conditioned one (KITTI: 0.003 deg), where VPs, with their degree of noise, must not move it.
+  // per pair by the estimator's rotation covariance plus rotation_drift_floor_deg per axis. That
+  // covariance tells a pair whose points barely separate rotation from translation (white panels
+  // seen from 2 m: 0.08 deg) from a well conditioned one (KITTI: 0.003 deg), where VPs, with
+  // their tenths of a degree of noise, must not move it.
   bool anchor_orientation = true;
-  double rotation_covariance_scale = 4.0;
   double rotation_drift_floor_deg = 0.005;
 };
 
@@ -251,6 +250,9 @@ class VisualOdometry {
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   double last_stamp_ = -1e300;
   bool tracker_seeded_ = false;
+  // The camera's last estimated rotation rate (rad/s, rotation vector of X2 = R X1 per second):
+  // the segments' motion prediction for the next frame.
+  Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace hybrid_vo

@@ -18,10 +18,15 @@
 namespace hybrid_vo {
 
 // camera_info to the front end's camera model. False with a reason when it cannot be used: zero
-// or non-finite K, zero image size, or a distortion model other than plumb_bob /
-// rational_polynomial with up to five coefficients (more are not supported).
+// or non-finite K, zero image size, non-finite coefficients, a distortion model other than
+// plumb_bob / rational_polynomial with up to five coefficients (more are not supported) or
+// equidistant with up to four, or equidistant coefficients that fold back inside the image.
 bool camera_from_info(const sensor_msgs::CameraInfo& info, CameraModel* camera,
                       std::string* reason);
+
+// camera_info's rectifying rotation R: identity when it is all zero (not set); false when it is
+// not a finite rotation matrix.
+bool rectification_from_info(const sensor_msgs::CameraInfo& info, Eigen::Matrix3d* R);
 
 // Stereo baseline in metres from the right camera's projection matrix (P[3] = -fx * B). False
 // when fx or Tx give no finite positive baseline.

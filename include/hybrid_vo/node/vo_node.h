@@ -15,7 +15,6 @@
 #include <hybrid_vo/FeatureLines.h>
 #include <hybrid_vo/FeaturePoints.h>
 #include <image_transport/image_transport.h>
-#include <image_transport/subscriber_filter.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/sync_policies/exact_time.h>
@@ -23,6 +22,7 @@
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud.h>
 #include <std_srvs/Empty.h>
@@ -31,6 +31,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/Marker.h>
 
+#include "hybrid_vo/frontend/fisheye_rectifier.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/node/frame_queue.h"
 #include "hybrid_vo/node/latency_window.h"
@@ -48,11 +49,21 @@ class VoNode {
   ~VoNode();
 
  private:
+  // An image as it arrived: raw, or compressed (image_transport: compressed), which the
+  // processing thread decodes.
+  struct FrameImage {
+    FrameImage() = default;
+    explicit FrameImage(sensor_msgs::ImageConstPtr image) : raw(std::move(image)) {}
+    explicit FrameImage(sensor_msgs::CompressedImageConstPtr image)
+        : compressed(std::move(image)) {}
+    sensor_msgs::ImageConstPtr raw;
+    sensor_msgs::CompressedImageConstPtr compressed;
+  };
   struct Frame {
     ros::Time stamp;
     std::chrono::steady_clock::time_point received;  // when it was complete
     std::string frame_id;
-    sensor_msgs::ImageConstPtr left, right;
+    FrameImage left, right;  // right empty for mono
     sensor_msgs::CameraInfoConstPtr left_info, right_info;
     bool have_images = false, have_points = false, have_lines = false;
     FeaturePoints::ConstPtr points;
@@ -69,6 +80,14 @@ class VoNode {
   // The frame's cameras, images and features for the odometry; false when one is unusable (the
   // frame is rejected and counted).
   bool read_input(const Frame& frame, VisualOdometryInput* input);
+  // An image in 8-bit grey; a compressed one is decoded, refused unless it has the camera's size,
+  // and its decoding time added to *decode_ms.
+  bool gray_of(const FrameImage& image, const CameraModel& camera, cv::Mat* gray,
+               double* decode_ms, std::string* reason) const;
+  // An equidistant camera's image rectified into the pinhole view (rectify_fisheye), its camera
+  // replaced by the view's; other cameras and images are left as they are.
+  bool rectify(const sensor_msgs::CameraInfo& info, FisheyeRectifier* rectifier,
+               CameraModel* camera, cv::Mat* image, std::string* reason);
   // The frame's outcome for the diagnostics.
   void record_result(const Frame& frame, const VisualOdometryResult& result, bool lost);
   // Resets or restarts the odometry for a fault in the stream (a valid frame of this stamp and
@@ -77,23 +96,31 @@ class VoNode {
   bool reset_callback(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
   void reset_state(const std::string& why);
 
-  // Inputs and synchronisation (vo_node_inputs.cc).
+  // Inputs and synchronisation (vo_node_inputs.cc). ImageMsg is sensor_msgs::Image or
+  // sensor_msgs::CompressedImage (image_transport: compressed, on <image topic>/compressed).
   void subscribe();
-  void mono_callback(const sensor_msgs::ImageConstPtr& image,
+  template <class ImageMsg>
+  void synchronise(message_filters::Subscriber<ImageMsg>* left,
+                   message_filters::Subscriber<ImageMsg>* right);
+  template <class ImageMsg>
+  void mono_callback(const boost::shared_ptr<const ImageMsg>& image,
                      const sensor_msgs::CameraInfoConstPtr& info);
-  void stereo_callback(const sensor_msgs::ImageConstPtr& left,
+  template <class ImageMsg>
+  void stereo_callback(const boost::shared_ptr<const ImageMsg>& left,
                        const sensor_msgs::CameraInfoConstPtr& left_info,
-                       const sensor_msgs::ImageConstPtr& right,
+                       const boost::shared_ptr<const ImageMsg>& right,
                        const sensor_msgs::CameraInfoConstPtr& right_info);
-  void raw_image_callback(const sensor_msgs::ImageConstPtr& image);
+  // Every image of the (left) topic, synchronised or not: tells "no images" from "images
+  // without camera_info".
+  template <class ImageMsg>
+  void image_arrived(const boost::shared_ptr<const ImageMsg>& image);
   void points_callback(const FeaturePoints::ConstPtr& msg);
   void lines_callback(const FeatureLines::ConstPtr& msg);
   void vins_points_callback(const sensor_msgs::PointCloud::ConstPtr& msg);
   void vins_lines_callback(const sensor_msgs::PointCloud::ConstPtr& msg);
-  // The synchronised images of a frame (right and right_info null for mono).
-  void add_images(const sensor_msgs::ImageConstPtr& left,
-                  const sensor_msgs::CameraInfoConstPtr& left_info,
-                  const sensor_msgs::ImageConstPtr& right,
+  // The synchronised images of a frame (right and right_info empty for mono).
+  void add_images(const std_msgs::Header& header, const FrameImage& left,
+                  const sensor_msgs::CameraInfoConstPtr& left_info, const FrameImage& right,
                   const sensor_msgs::CameraInfoConstPtr& right_info);
   template <class MessagePtr>
   void add_features(const MessagePtr& msg, MessagePtr Frame::*part, bool Frame::*have);
@@ -132,14 +159,16 @@ class VoNode {
   // Under stats_mutex_.
   void add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) const;
   void add_counters(diagnostic_updater::DiagnosticStatusWrapper& status) const;
+  void add_input(diagnostic_updater::DiagnosticStatusWrapper& status) const;
   void add_vp_tracks(diagnostic_updater::DiagnosticStatusWrapper& status) const;
 
   ros::NodeHandle nh_, pnh_;
-  image_transport::ImageTransport it_;
 
   // Parameters.
   std::string odom_frame_, base_frame_;
   bool stereo_ = false, approximate_sync_ = false, publish_tf_ = true;
+  bool compressed_ = false;  // image_transport: compressed
+  bool rectify_fisheye_ = true;
   bool use_feature_points_ = false, use_feature_lines_ = false, vins_format_ = false;
   bool publish_debug_image_ = true, publish_markers_ = true;
   int queue_size_ = 10;
@@ -148,22 +177,15 @@ class VoNode {
   double camera_info_timeout_ = 2.0;
   VisualOdometryOptions vo_options_;
 
-  // Input.
-  using ExactMono = message_filters::sync_policies::ExactTime<sensor_msgs::Image,
-                                                              sensor_msgs::CameraInfo>;
-  using ApproxMono = message_filters::sync_policies::ApproximateTime<sensor_msgs::Image,
-                                                                     sensor_msgs::CameraInfo>;
-  using ExactStereo = message_filters::sync_policies::ExactTime<
-      sensor_msgs::Image, sensor_msgs::CameraInfo, sensor_msgs::Image, sensor_msgs::CameraInfo>;
-  using ApproxStereo = message_filters::sync_policies::ApproximateTime<
-      sensor_msgs::Image, sensor_msgs::CameraInfo, sensor_msgs::Image, sensor_msgs::CameraInfo>;
-  image_transport::SubscriberFilter left_sub_, right_sub_;
+  // Input: one pair of image subscribers is in use (raw or compressed), and one synchroniser
+  // (mono or stereo, exact or approximate time, of those images), held type-erased.
+  message_filters::Subscriber<sensor_msgs::Image> left_sub_, right_sub_;
+  message_filters::Subscriber<sensor_msgs::CompressedImage> left_compressed_sub_,
+      right_compressed_sub_;
   message_filters::Subscriber<sensor_msgs::CameraInfo> left_info_sub_, right_info_sub_;
-  std::unique_ptr<message_filters::Synchronizer<ExactMono>> exact_mono_;
-  std::unique_ptr<message_filters::Synchronizer<ApproxMono>> approx_mono_;
-  std::unique_ptr<message_filters::Synchronizer<ExactStereo>> exact_stereo_;
-  std::unique_ptr<message_filters::Synchronizer<ApproxStereo>> approx_stereo_;
-  ros::Subscriber raw_image_sub_, points_sub_, lines_sub_;
+  std::shared_ptr<void> sync_;
+  std::string image_topic_;  // the (left) image topic subscribed, for diagnostics
+  ros::Subscriber arrival_sub_, points_sub_, lines_sub_;
   ros::ServiceServer reset_service_;
   ros::Timer watchdog_timer_;
 
@@ -185,6 +207,8 @@ class VoNode {
   // touches the odometry and the publishers' state.
   std::mutex process_mutex_;
   std::unique_ptr<VisualOdometry> vo_;
+  // Per camera: the remap tables of the last equidistant camera_info.
+  FisheyeRectifier left_rectifier_, right_rectifier_;
   StreamMonitor monitor_;
   bool have_base_transform_ = false, looked_up_base_ = false;
   Eigen::Matrix3d R_base_camera_ = Eigen::Matrix3d::Identity();
@@ -198,16 +222,18 @@ class VoNode {
   diagnostic_updater::Updater updater_;
   double min_frequency_ = 1.0, max_frequency_ = 100.0;
   std::unique_ptr<diagnostic_updater::FrequencyStatus> frequency_;
-  ros::Time last_raw_image_, last_synced_image_;
+  ros::Time last_image_, last_synced_image_;
   int unsynced_images_ = 0;  // images since the last synchronised frame
   ros::Time last_processed_;
   VisualOdometryResult last_result_;
   std::string last_problem_;
+  std::string camera_model_;  // the last frame's lens model and what the node made of it
   int frames_ = 0, invalid_camera_info_ = 0, bad_images_ = 0, failures_ = 0, dropped_ = 0,
       bad_features_ = 0, camera_info_outages_ = 0;
   bool camera_info_outage_ = false;
   StreamCounters stream_counters_;
   LatencyWindow latency_ms_;
+  LatencyWindow decode_ms_;  // per frame, compressed images only
   // Stereo frames whose scale fell back to mono_scale, and the last reason.
   int stereo_scale_fallbacks_ = 0;
   std::string last_scale_fallback_;

@@ -1,6 +1,7 @@
 #pragma once
 
-// Ray casting of a render::Scene through a pinhole camera into an 8-bit grey image.
+// Ray casting of a render::Scene through a pinhole camera, or an equidistant (fisheye) one, into
+// an 8-bit grey image.
 //
 // Every pixel averages ss x ss rays (box filter) whose hits are found exactly, so geometric
 // edges are antialiased; textures are sampled with anisotropic trilinear mip-mapping at each
@@ -12,6 +13,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "hybrid_vo/frontend/camera_model.h"
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/render/camera_path.h"
 #include "hybrid_vo/render/scene.h"
@@ -40,6 +42,19 @@ struct RenderedView {
 // invalid camera or options.
 RenderedView render_view(const Scene& scene, const PinholeCamera& camera, const CameraPose& pose,
                          const RenderOptions& options = {});
+
+// The view of a camera with a lens: one without distortion exactly as above; an equidistant
+// (fisheye) one by casting every sample's ray through its lens model, also beyond 90 degrees off
+// the axis (depth is then the surface's camera z, negative behind the image plane). Other
+// distortions are refused (std::invalid_argument), as are lens coefficients that fold back.
+RenderedView render_view(const Scene& scene, const CameraModel& camera, const CameraPose& pose,
+                         const RenderOptions& options = {});
+
+// The renderer's fisheye for a width x height image: an equidistant lens whose horizontal field
+// of view is fov_deg across the image (to its outer edges), principal point at the centre,
+// square pixels, and the coefficients of a real lens (k1..k4 = -0.02, 0.003, -0.0005, 0.0001).
+// Throws std::invalid_argument for a field of view outside (0, 220) degrees.
+CameraModel fisheye_camera(double fov_deg, int width = 640, int height = 480);
 
 // The nearest quad that the ray origin + t direction hits from its front side (as drawn), at
 // t > near: its index, or -1, with t. For a direction of camera z 1, t is the camera depth, the

@@ -36,9 +36,14 @@ struct SequenceOptions {
   double baseline = 0.12;  // metres, stereo only
   double speed = 1.5;      // metres per second
   double focal = 0.0;      // pixels; 0: 0.72 * width
+  // > 0: an equidistant (fisheye) lens of this horizontal field of view in degrees
+  // (fisheye_camera), instead of the pinhole.
+  double fisheye_fov = 0.0;
   double noise = 1.0;      // grey levels
   int supersampling = 3;
   std::string compression = "lz4";  // none, lz4 or bz2
+  std::string compressed_images;    // empty: raw images; png or jpeg: CompressedImage topics
+  int jpeg_quality = 95;
   bool help = false;
 };
 
@@ -58,7 +63,8 @@ struct Sequence {
   SequenceOptions options;
   Scene scene;
   Trajectory trajectory;
-  PinholeCamera camera;  // both cameras of a stereo pair
+  PinholeCamera camera;  // both cameras of a stereo pair: K (of the fisheye too)
+  CameraModel lens;      // camera without distortion, or the fisheye
   RenderOptions render;
 };
 

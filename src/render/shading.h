@@ -1,0 +1,39 @@
+#pragma once
+
+// What the renderer's cameras share (renderer.cc: pinhole, fisheye_view.cc: equidistant): the
+// checks of the options and pose, the shading of a ray's hit on a quad, and the finishing of the
+// radiance into the 8-bit image.
+
+#include <string>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "hybrid_vo/render/renderer.h"
+
+namespace hybrid_vo {
+namespace render {
+
+// Throws std::invalid_argument("render: " + what) unless ok.
+void check(bool ok, const std::string& what);
+// The options and the pose of a render_view call (throws as check).
+void check_render_inputs(const RenderOptions& options, const CameraPose& pose);
+
+// A CV_8UC1 or CV_32FC1 image at (x, y), clamped to the image.
+float bilinear(const cv::Mat& m, double x, double y);
+
+// Texture lookup at level-0 texel coordinates (tu, tv), texel c covering [c, c + 1); (du, dv)
+// per sample step along the image x and y axes give the footprint.
+double sample_texture(const Texture& tex, double tu, double tv, double dux, double dvx, double duy,
+                      double dvy, int max_anisotropy);
+
+// Radiance (albedo times irradiance) of quad q at its plane coordinates uv, for a ray whose hit
+// moves by dX_dx and dX_dy (world) per sample step along the image x and y axes.
+double shade(const Quad& q, const Eigen::Vector2d& uv, const Eigen::Vector3d& dX_dx,
+             const Eigen::Vector3d& dX_dy, int max_anisotropy);
+
+// The sensor: blur, noise and 8-bit quantisation of a CV_32FC1 radiance image.
+cv::Mat finish(cv::Mat radiance, const RenderOptions& options);
+
+}  // namespace render
+}  // namespace hybrid_vo
