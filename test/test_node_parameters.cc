@@ -81,6 +81,7 @@ std::vector<Case> every_parameter() {
       {"min_parallax_px", 3.5, [](P p) { return p.odometry.min_parallax_px == 3.5; }},
       {"track_lines", false, [](P p) { return !p.odometry.track_lines; }},
       {"concurrent_frontend", false, [](P p) { return !p.odometry.concurrent; }},
+      {"opencv_threads", -1, [](P p) { return p.opencv_threads == -1; }},
       {"klt_predict_motion", false, [](P p) { return !p.odometry.klt.predict_motion; }},
       {"klt_window_px", 21, [](P p) { return p.odometry.klt.window_px == 21; }},
       {"klt_min_corner_gradient", 1.5,

@@ -1,9 +1,11 @@
 // Stereo scale (estimation/stereo_scale) on synthetic highway-like scenes, stereo matching
-// (frontend/stereo) on a rendered pair with known depth, and the affine refinement of the
-// scale's current points (frontend/affine_tracking) on a synthetic approaching plane.
+// (frontend/stereo) on a rendered pair with known depth and split over threads, and the affine
+// refinement of the scale's current points (frontend/affine_tracking) on a synthetic
+// approaching plane.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <random>
 #include <vector>
@@ -15,6 +17,7 @@
 #include "hybrid_vo/estimation/stereo_scale.h"
 #include "hybrid_vo/frontend/affine_tracking.h"
 #include "hybrid_vo/frontend/stereo.h"
+#include "hybrid_vo/frontend/worker_thread.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/rotation.h"
 #include "hybrid_vo/render/sequence.h"
@@ -276,6 +279,70 @@ TEST(StereoPoints, RenderedPairHasUnbiasedDisparities) {
   const std::vector<Eigen::Vector3d> none = stereo_points(
       left.image, right.image(cv::Rect(0, 0, 100, 100)), pixels, camera, 0.1, &valid);
   EXPECT_TRUE(std::all_of(valid.begin(), valid.end(), [](char v) { return !v; }));
+}
+
+// Issue 32: the searches split over threads (backwards, and on a worker thread beside this one)
+// give the points of one thread, with and without predicted disparities.
+TEST(StereoPoints, SplitSearchesGiveTheSamePoints) {
+  cv::Mat noise(300, 500, CV_8U);
+  cv::randu(noise, 0, 255);
+  cv::Mat left;
+  cv::GaussianBlur(noise, left, cv::Size(0, 0), 2.0);
+  cv::normalize(left, left, 0, 255, cv::NORM_MINMAX);
+  // The right image: the left one sheared, disparity 8 px at the top to 20 px at the bottom.
+  cv::Mat right;
+  cv::Mat map_x(left.size(), CV_32F), map_y(left.size(), CV_32F);
+  for (int y = 0; y < left.rows; ++y)
+    for (int x = 0; x < left.cols; ++x) {
+      map_x.at<float>(y, x) = x + 8.0f + 12.0f * y / left.rows;
+      map_y.at<float>(y, x) = static_cast<float>(y);
+    }
+  cv::remap(left, right, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(left, corners, 400, 0.01, 7);
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<double> predicted;
+  for (const cv::Point2f& c : corners) {
+    pixels.emplace_back(c.x, c.y);
+    predicted.push_back(pixels.size() % 3 ? 8.0 + 12.0 * c.y / left.rows + 1.5
+                                          : std::numeric_limits<double>::quiet_NaN());
+  }
+  PinholeCamera camera;
+  camera.fx = camera.fy = 400.0;
+  camera.cx = 250.0;
+  camera.cy = 150.0;
+  camera.width = left.cols;
+  camera.height = left.rows;
+  const StereoOptions options;
+  const std::vector<cv::Mat> left_pyramid = stereo_pyramid(left, options);
+  const std::vector<cv::Mat> right_pyramid = stereo_pyramid(right, options);
+  auto backwards = [](int n, const std::function<void(int)>& body) {
+    for (int i = n - 1; i >= 0; --i) body(i);
+  };
+  WorkerThread worker;
+  for (const std::vector<double>& prediction : {std::vector<double>(), predicted}) {
+    std::vector<char> valid, valid_backwards, valid_threaded;
+    const std::vector<Eigen::Vector3d> X = stereo_points(
+        left_pyramid, right_pyramid, pixels, camera, 0.1, &valid, options, prediction);
+    const std::vector<Eigen::Vector3d> Xb = stereo_points(
+        left_pyramid, right_pyramid, pixels, camera, 0.1, &valid_backwards, options, prediction,
+        backwards);
+    const std::vector<Eigen::Vector3d> Xt = stereo_points(
+        left_pyramid, right_pyramid, pixels, camera, 0.1, &valid_threaded, options, prediction,
+        worker.parallel());
+    EXPECT_GT(std::count(valid.begin(), valid.end(), 1), static_cast<long>(pixels.size()) / 2);
+    EXPECT_EQ(valid, valid_backwards);
+    EXPECT_EQ(valid, valid_threaded);
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      EXPECT_EQ(X[i], Xb[i]) << i;
+      EXPECT_EQ(X[i], Xt[i]) << i;
+    }
+    // From the images: the same points again.
+    std::vector<char> valid_images;
+    const std::vector<Eigen::Vector3d> Xi =
+        stereo_points(left, right, pixels, camera, 0.1, &valid_images, options, prediction);
+    EXPECT_EQ(valid, valid_images);
+  }
 }
 
 // A textured floor that the camera approaches (as the corridor's, drawn here without the

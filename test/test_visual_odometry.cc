@@ -1,13 +1,16 @@
 // The video front end on a rendered sequence: the threaded front end gives exactly the matches
 // and poses of the sequential one, segment tracking is as correct as full LBD matching without
 // using any point, the stereo scale's current points do not lag on approaching
-// surfaces, and the worker thread and the tracker behave at their edges.
+// surfaces, the KLT tracker split over threads tracks as the sequential one, and the worker
+// thread and the tracker behave at their edges.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <string>
+#include <future>
 #include <stdexcept>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -328,6 +331,69 @@ TEST(KltTracker, StampsCarryThePredictionOverADroppedFrame) {
   EXPECT_GT(correct_with, correct_without + with / 10) << correct_without << " of " << without;
 }
 
+// Runs the indices of a ParallelFor backwards: whatever order the threads take them in, each
+// index writes only its own results.
+void backwards(int n, const std::function<void(int)>& body) {
+  for (int i = n - 1; i >= 0; --i) body(i);
+}
+
+bool same_tracker(const KltTracker& a, const KltTracker& b) {
+  return a.ids() == b.ids() && a.points() == b.points();
+}
+
+// Issue 32: the searches and the re-detection's cells split over threads (here: backwards, and
+// on a worker thread beside this one) give the tracks of the sequential tracker, also when
+// max_features leaves less room than the empty cells want.
+TEST(KltTracker, SplitSearchesAndCellsGiveTheSameTracks) {
+  cv::Mat noise(700, 1000, CV_8U);
+  cv::randu(noise, 0, 255);
+  cv::Mat texture;
+  cv::GaussianBlur(noise, texture, cv::Size(0, 0), 2.5);
+  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+  // Zooming in about a point left of centre: the flow differs across the image and features
+  // leave it on the left, so tracks are lost and cells refilled unevenly.
+  auto frame = [&](int k) {
+    const double zoom = 1.0 + 0.03 * k;
+    const cv::Matx23d warp(zoom, 0, (1 - zoom) * 300 - 150, 0, zoom, (1 - zoom) * 350 - 100);
+    cv::Mat image;
+    cv::warpAffine(texture, image, warp, cv::Size(640, 480),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+    return image;
+  };
+  const KltTrackerOptions options;
+  constexpr int kMaxFeatures = 300;
+  KltTracker sequential(options, kMaxFeatures), reversed(options, kMaxFeatures),
+      threaded(options, kMaxFeatures);
+  WorkerThread worker;
+  int capped = 0;
+  for (int k = 0; k < 8; ++k) {
+    const cv::Mat image = frame(k);
+    const double stamp = 0.1 * k;
+    std::vector<int64_t> ids_sequential, ids_reversed, ids_threaded;
+    const std::vector<PointMatch> a = sequential.track_existing(image, &ids_sequential, stamp);
+    const std::vector<PointMatch> b =
+        reversed.track_existing(image, &ids_reversed, stamp, backwards);
+    const std::vector<PointMatch> c =
+        threaded.track_existing(image, &ids_threaded, stamp, worker.parallel());
+    EXPECT_TRUE(same_points(a, b) && same_points(a, c)) << "frame " << k;
+    EXPECT_TRUE(ids_sequential == ids_reversed && ids_sequential == ids_threaded) << "frame " << k;
+    if (k > 0) {
+      EXPECT_GT(a.size(), 100u);
+    }
+    // Does max_features leave less room than the cells want?
+    const KltDetection plan = sequential.plan_detection();
+    int wanted = 0;
+    for (int w : plan.wanted) wanted += std::max(0, w);
+    capped += wanted > kMaxFeatures - sequential.num_tracks();
+    sequential.detect_new();
+    reversed.detect_new(backwards);
+    threaded.detect_new(worker.parallel());
+    EXPECT_TRUE(same_tracker(sequential, reversed)) << "frame " << k;
+    EXPECT_TRUE(same_tracker(sequential, threaded)) << "frame " << k;
+  }
+  EXPECT_GT(capped, 0) << "the cap on features never bound";
+}
+
 // Issue 30: the rendered corridor with plain walls (only edges, corners and floor joints;
 // points find sensor noise). Each estimated pair's rotation error against the renderer's truth,
 // for a preset, in degrees.
@@ -541,6 +607,53 @@ TEST(WorkerThread, RunsJobsInOrderAndRethrowsTheirErrors) {
     int value = 0;
     worker.submit([&] { value = 7; }).get();
     EXPECT_EQ(value, 7);
+  }
+}
+
+TEST(WorkerThread, SharedLoopsRunEachIndexOnceAndRethrow) {
+  for (const bool concurrent : {true, false}) {
+    WorkerThread worker(concurrent);
+    // A job that keeps the worker busy until released (a sequential worker has none: it runs
+    // shared loops only when they are joined).
+    std::promise<void> release;
+    auto occupy = [&] {
+      release = std::promise<void>();
+      std::shared_future<void> released = release.get_future().share();
+      return concurrent ? worker.submit([released] { released.wait(); }) : WorkerJob();
+    };
+    // The worker is busy when the loop is shared: the caller runs what it has not taken.
+    WorkerJob busy = occupy();
+    std::vector<int> runs(100, 0);
+    SharedLoop loop = worker.share(100, [&](int i) { ++runs[i]; });
+    loop.join();
+    EXPECT_EQ(runs, std::vector<int>(100, 1));
+    release.set_value();
+    busy.get();
+    // Both threads at once.
+    std::vector<std::atomic<int>> counts(1000);
+    worker.parallel_for(1000, [&](int i) { ++counts[i]; });
+    for (const std::atomic<int>& c : counts) EXPECT_EQ(c.load(), 1);
+    // The first error is rethrown once every index has run or been left.
+    std::atomic<int> ran{0};
+    EXPECT_THROW(worker.parallel_for(50,
+                                     [&](int i) {
+                                       ++ran;
+                                       if (i == 7) throw std::runtime_error("index failed");
+                                     }),
+                 std::runtime_error);
+    EXPECT_EQ(ran.load(), 50);
+    // A cancelled loop runs no index that had not started.
+    busy = occupy();
+    int started = 0;
+    SharedLoop cancelled = worker.share(10, [&](int) { ++started; });
+    cancelled.cancel();
+    release.set_value();
+    busy.get();
+    EXPECT_EQ(started, 0);
+    // An empty loop, and an empty handle.
+    worker.parallel_for(0, [](int) { FAIL(); });
+    SharedLoop empty;
+    EXPECT_NO_THROW(empty.join());
   }
 }
 

@@ -117,14 +117,61 @@ std::vector<char> KltTracker::predict(double motion_scale, std::vector<cv::Point
 }
 
 std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int64_t>* ids,
-                                          double stamp) {
-  std::vector<PointMatch> matches = track_existing(image, ids, stamp);
-  detect_new();
+                                          double stamp, const ParallelFor& parallel) {
+  std::vector<PointMatch> matches = track_existing(image, ids, stamp, parallel);
+  detect_new(parallel);
   return matches;
 }
 
+// One frame's searches, a slot per feature of the previous frame.
+struct KltTracker::Search {
+  std::vector<cv::Point2f> predicted_at;  // where the search starts
+  std::vector<char> predicted;            // whether it has a prediction (else: the long way)
+  int short_levels = 0;
+  std::vector<cv::Point2f> next, back;    // found in this frame, and back in the previous one
+  std::vector<char> found, back_found, long_way;
+};
+
+void KltTracker::search_range(const std::vector<cv::Mat>& pyramid, int begin, int end,
+                              Search* s) const {
+  // Forward: short searches from the predictions; what they lose, and what has no prediction,
+  // the long way.
+  std::vector<int> short_search, long_search;
+  const cv::Rect2f bounds(0.0f, 0.0f, pyramid[0].cols - 1.0f, pyramid[0].rows - 1.0f);
+  for (int i = begin; i < end; ++i) {
+    if (s->predicted[i] && options_.drop_leaving && !bounds.contains(s->predicted_at[i]))
+      continue;  // lost without a search (found stays 0)
+    (s->predicted[i] ? short_search : long_search).push_back(i);
+  }
+  search(previous_, pyramid, points_, short_search, s->short_levels, options_, &s->next,
+         &s->found);
+  for (int i : short_search)
+    if (!s->found[i]) long_search.push_back(i);
+  std::sort(long_search.begin(), long_search.end());
+  for (int i : long_search) s->long_way[i] = 1;
+  search(previous_, pyramid, points_, long_search, -1, options_, &s->next, &s->found);
+
+  // Forward-backward consistency (Kalal et al. 2010) rejects drifting and occluded tracks. The
+  // backward search mirrors the forward one: a feature found the short way is searched for
+  // back from its position minus the predicted motion, over the same levels. A feature found
+  // outside the image is lost whatever the way back says, so it is not searched for.
+  std::vector<int> back_short, back_long;
+  for (int i = begin; i < end; ++i) {
+    if (!s->found[i] || !bounds.contains(s->next[i])) continue;
+    if (s->long_way[i]) {
+      back_long.push_back(i);
+    } else {
+      back_short.push_back(i);
+      s->back[i] = s->next[i] - (s->predicted_at[i] - points_[i]);
+    }
+  }
+  search(pyramid, previous_, s->next, back_short, s->short_levels, options_, &s->back,
+         &s->back_found);
+  search(pyramid, previous_, s->next, back_long, -1, options_, &s->back, &s->back_found);
+}
+
 std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image, std::vector<int64_t>* ids,
-                                                   double stamp) {
+                                                   double stamp, const ParallelFor& parallel) {
   std::vector<PointMatch> matches;
   if (ids) ids->clear();
   if (image.empty()) return matches;
@@ -137,58 +184,37 @@ std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image, std::ve
   cv::buildOpticalFlowPyramid(gray, pyramid, window, options_.pyramid_levels, true);
 
   if (!previous_.empty() && !points_.empty()) {
-    const size_t n = points_.size();
-    std::vector<cv::Point2f> predicted_at;
-    const std::vector<char> predicted = predict(motion_scale(stamp), &predicted_at);
-    const int short_levels =
+    const int n = static_cast<int>(points_.size());
+    Search s;
+    s.predicted = predict(motion_scale(stamp), &s.predicted_at);
+    s.short_levels =
         std::max(0, std::min(options_.predicted_pyramid_levels, options_.pyramid_levels));
-    // Forward: short searches from the predictions; what they lose, and what has no prediction,
-    // the long way.
-    std::vector<cv::Point2f> next = predicted_at;
-    std::vector<char> found(n, 0), long_way(n, 0);
-    std::vector<int> short_search, long_search;
-    for (size_t i = 0; i < n; ++i)
-      (predicted[i] ? short_search : long_search).push_back(static_cast<int>(i));
-    search(previous_, pyramid, points_, short_search, short_levels, options_, &next, &found);
-    for (int i : short_search)
-      if (!found[i]) long_search.push_back(i);
-    std::sort(long_search.begin(), long_search.end());
-    for (int i : long_search) long_way[i] = 1;
-    search(previous_, pyramid, points_, long_search, -1, options_, &next, &found);
-
-    // Forward-backward consistency (Kalal et al. 2010) rejects drifting and occluded tracks. The
-    // backward search mirrors the forward one: a feature found the short way is searched for
-    // back from its position minus the predicted motion, over the same levels.
-    std::vector<cv::Point2f> back(n);
-    std::vector<char> back_found(n, 0);
-    std::vector<int> back_short, back_long;
-    for (size_t i = 0; i < n; ++i) {
-      if (!found[i]) continue;
-      if (long_way[i]) {
-        back_long.push_back(static_cast<int>(i));
-      } else {
-        back_short.push_back(static_cast<int>(i));
-        back[i] = next[i] - (predicted_at[i] - points_[i]);
-      }
-    }
-    search(pyramid, previous_, next, back_short, short_levels, options_, &back, &back_found);
-    search(pyramid, previous_, next, back_long, -1, options_, &back, &back_found);
+    s.next = s.predicted_at;
+    s.back.resize(n);
+    s.found.assign(n, 0);
+    s.back_found.assign(n, 0);
+    s.long_way.assign(n, 0);
+    // Chunks of features, small enough for two threads to share the work evenly.
+    constexpr int kChunk = 32;
+    run_indices(parallel, (n + kChunk - 1) / kChunk, [&](int chunk) {
+      search_range(pyramid, chunk * kChunk, std::min(n, (chunk + 1) * kChunk), &s);
+    });
 
     std::vector<cv::Point2f> kept, kept_motion;
     std::vector<int64_t> kept_ids;
-    const cv::Rect2f bounds(0.0f, 0.0f, gray.cols - 1.0f, gray.rows - 1.0f);
     const double max_fb_sq = options_.max_forward_backward_px * options_.max_forward_backward_px;
-    for (size_t i = 0; i < n; ++i) {
-      if (!found[i] || !back_found[i] || !bounds.contains(next[i])) continue;
-      const cv::Point2f d = back[i] - points_[i];
+    for (int i = 0; i < n; ++i) {
+      // Found outside the image: never searched back (search_range).
+      if (!s.found[i] || !s.back_found[i]) continue;
+      const cv::Point2f d = s.back[i] - points_[i];
       if (d.dot(d) > max_fb_sq) continue;
       PointMatch m;
       m.x1 = Eigen::Vector2d(points_[i].x, points_[i].y);
-      m.x2 = Eigen::Vector2d(next[i].x, next[i].y);
+      m.x2 = Eigen::Vector2d(s.next[i].x, s.next[i].y);
       matches.push_back(m);
       if (ids) ids->push_back(ids_[i]);
-      kept.push_back(next[i]);
-      kept_motion.push_back(next[i] - points_[i]);
+      kept.push_back(s.next[i]);
+      kept_motion.push_back(s.next[i] - points_[i]);
       kept_ids.push_back(ids_[i]);
     }
     points_ = std::move(kept);
@@ -203,8 +229,18 @@ std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image, std::ve
   return matches;
 }
 
-void KltTracker::detect_new() {
-  if (previous_.empty()) return;
+void KltTracker::detect_new(const ParallelFor& parallel) {
+  KltDetection detection = plan_detection();
+  run_indices(parallel, detection.cells(), [&](int cell) { detect_cell(&detection, cell); });
+  add_detections(detection);
+}
+
+KltDetection KltTracker::plan_detection() const {
+  KltDetection d;
+  if (previous_.empty()) {
+    d.cols = d.rows = 0;
+    return d;
+  }
   // Level 0 of the pyramid is the image (inside the border the pyramid adds).
   const cv::Mat& gray = previous_[0];
   // Re-detection by buckets keeps features spread over the image (a cluster of tracks on one
@@ -217,38 +253,58 @@ void KltTracker::detect_new() {
     if (cols >= rows) --cols;
     else --rows;
   }
-  const int cells = cols * rows;
-  const int quota = std::max(1, max_features / cells);
-  const int cell_w = (gray.cols + cols - 1) / cols;
-  const int cell_h = (gray.rows + rows - 1) / rows;
-  std::vector<int> count(cells, 0);
-  cv::Mat mask(gray.size(), CV_8U, cv::Scalar(255));
+  d.cols = cols;
+  d.rows = rows;
+  const int quota = std::max(1, max_features / d.cells());
+  d.cell_w = (gray.cols + cols - 1) / cols;
+  d.cell_h = (gray.rows + rows - 1) / rows;
+  std::vector<int> count(d.cells(), 0);
+  d.mask = cv::Mat(gray.size(), CV_8U, cv::Scalar(255));
   for (const cv::Point2f& p : points_) {
-    const int cx = std::min(cols - 1, static_cast<int>(p.x) / cell_w);
-    const int cy = std::min(rows - 1, static_cast<int>(p.y) / cell_h);
+    const int cx = std::min(cols - 1, static_cast<int>(p.x) / d.cell_w);
+    const int cy = std::min(rows - 1, static_cast<int>(p.y) / d.cell_h);
     ++count[cy * cols + cx];
-    cv::circle(mask, p, static_cast<int>(options_.min_distance_px), cv::Scalar(0), cv::FILLED);
+    cv::circle(d.mask, p, static_cast<int>(options_.min_distance_px), cv::Scalar(0), cv::FILLED);
   }
-  for (int cy = 0; cy < rows; ++cy) {
-    for (int cx = 0; cx < cols; ++cx) {
-      const int room = max_features - static_cast<int>(points_.size());
-      const int missing = std::min(room, quota - count[cy * cols + cx]);
-      if (missing <= 0) continue;
-      const cv::Rect cell = cv::Rect(cx * cell_w, cy * cell_h, cell_w, cell_h) &
-                            cv::Rect(0, 0, gray.cols, gray.rows);
-      if (cell.width < 8 || cell.height < 8) continue;
-      std::vector<cv::Point2f> corners;
-      cv::goodFeaturesToTrack(gray(cell), corners, missing, options_.quality_level,
-                              options_.min_distance_px, mask(cell));
-      for (const cv::Point2f& c0 : corners) {
-        const cv::Point2f c = c0 + cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y));
-        if (options_.min_corner_gradient > 0.0 &&
-            corner_gradient(gray, c, options_.window_px) < options_.min_corner_gradient)
-          continue;
-        points_.push_back(c);
-        motion_.push_back(cv::Point2f(kUnknown, kUnknown));
-        ids_.push_back(next_id_++);
-      }
+  d.wanted.resize(d.cells());
+  for (int c = 0; c < d.cells(); ++c) d.wanted[c] = quota - count[c];
+  d.corners.resize(d.cells());
+  d.strong.resize(d.cells());
+  return d;
+}
+
+void KltTracker::detect_cell(KltDetection* d, int c) const {
+  if (previous_.empty() || c < 0 || c >= d->cells() || d->wanted[c] <= 0) return;
+  const cv::Mat& gray = previous_[0];
+  const int cx = c % d->cols, cy = c / d->cols;
+  const cv::Rect cell = cv::Rect(cx * d->cell_w, cy * d->cell_h, d->cell_w, d->cell_h) &
+                        cv::Rect(0, 0, gray.cols, gray.rows);
+  if (cell.width < 8 || cell.height < 8) return;
+  // All the cell may want: add_detections takes fewer when max_features leaves less room, and
+  // goodFeaturesToTrack's first k corners are the same whatever the maximum (it admits them
+  // strongest first and stops at the maximum).
+  std::vector<cv::Point2f>& corners = d->corners[c];
+  cv::goodFeaturesToTrack(gray(cell), corners, d->wanted[c], options_.quality_level,
+                          options_.min_distance_px, d->mask(cell));
+  d->strong[c].assign(corners.size(), 1);
+  for (size_t k = 0; k < corners.size(); ++k) {
+    corners[k] += cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y));
+    if (options_.min_corner_gradient > 0.0 &&
+        corner_gradient(gray, corners[k], options_.window_px) < options_.min_corner_gradient)
+      d->strong[c][k] = 0;
+  }
+}
+
+void KltTracker::add_detections(const KltDetection& d) {
+  const int max_features = std::max(1, max_features_);
+  for (int c = 0; c < d.cells() && c < static_cast<int>(d.corners.size()); ++c) {
+    const int room = max_features - static_cast<int>(points_.size());
+    const int take = std::min({room, d.wanted[c], static_cast<int>(d.corners[c].size())});
+    for (int k = 0; k < take; ++k) {
+      if (!d.strong[c][k]) continue;
+      points_.push_back(d.corners[c][k]);
+      motion_.push_back(cv::Point2f(kUnknown, kUnknown));
+      ids_.push_back(next_id_++);
     }
   }
   // Tracks crowding into a few cells can still exceed the cap: keep the oldest (lowest ids).

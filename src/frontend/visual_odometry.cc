@@ -38,6 +38,14 @@ std::vector<VpObservation> vp_observations(const Eigen::Matrix3d& K, const TwoVi
   return observations;
 }
 
+// The median image motion of the point matches (pixels).
+double median_motion_px(const std::vector<PointMatch>& matches) {
+  std::vector<double> motion;
+  for (const PointMatch& p : matches) motion.push_back((p.x2 - p.x1).norm());
+  std::nth_element(motion.begin(), motion.begin() + motion.size() / 2, motion.end());
+  return motion[motion.size() / 2];
+}
+
 bool uses_vps(const RelativePoseEstimatorOptions& options) {
   for (const SolverInfo& info : solver_table())
     if (options.ransac.enabled[static_cast<int>(info.id)] && info.num_vps > 0) return true;
@@ -114,50 +122,82 @@ void VisualOdometry::restart() {
   tracker_seeded_ = false;
 }
 
-std::map<int64_t, Eigen::Vector3d> VisualOdometry::stereo_of(
-    const VisualOdometryInput& input, const cv::Mat& gray, const std::vector<cv::Mat>* left_pyramid,
-    const std::map<int64_t, Eigen::Vector2d>& points) const {
-  // Stereo: metric 3D points of the frame's features, for the scale of this and the next motion.
+std::map<int64_t, Eigen::Vector3d> VisualOdometry::StereoFeatures::points() const {
   std::map<int64_t, Eigen::Vector3d> points3d;
-  if (!input.right_image.empty() && input.baseline_m > 0.0 && !points.empty()) {
-    std::vector<int64_t> ids;
-    std::vector<Eigen::Vector2d> pixels;
-    // A track's disparity in the keyframe (usually the previous frame) is where its search starts
-    // (descriptor features have no tracks: their ids are indices into one frame).
-    std::vector<double> predicted;
-    const double fx_baseline = keyframe_.camera.pinhole.fx * input.baseline_m;
-    const bool tracks = input.external.has_points ||
-                        options_.point_source == PointFeatureSource::kTracking;
-    for (const auto& [id, p] : points) {
-      ids.push_back(id);
-      pixels.push_back(p);
-      const auto it = keyframe_.valid && tracks ? keyframe_.points3d.find(id)
-                                                : keyframe_.points3d.end();
-      predicted.push_back(it != keyframe_.points3d.end() ? fx_baseline / it->second.z()
-                                                          : std::numeric_limits<double>::quiet_NaN());
-    }
-    std::vector<char> valid;
-    const cv::Mat right = to_gray8(input.right_image);
-    const std::vector<Eigen::Vector3d> X =
-        left_pyramid ? stereo_points(*left_pyramid, right, pixels, input.camera.pinhole,
-                                     input.baseline_m, &valid, options_.stereo, predicted)
-                     : stereo_points(gray, right, pixels, input.camera.pinhole, input.baseline_m,
-                                     &valid, options_.stereo, predicted);
-    for (size_t i = 0; i < ids.size(); ++i)
-      if (valid[i]) points3d[ids[i]] = X[i];
-  }
+  if (!matcher) return points3d;
+  std::vector<char> valid;
+  const std::vector<Eigen::Vector3d> X = matcher->points(&valid);
+  for (size_t i = 0; i < ids.size(); ++i)
+    if (valid[i]) points3d[ids[i]] = X[i];
   return points3d;
+}
+
+VisualOdometry::StereoFeatures VisualOdometry::stereo_features(
+    const StereoPair& pair, const std::map<int64_t, Eigen::Vector2d>& points, bool predict) const {
+  StereoFeatures stereo;
+  std::vector<Eigen::Vector2d> pixels;
+  // A track's disparity in the keyframe (usually the previous frame) is where its search starts
+  // (descriptor features have no tracks: their ids are indices into one frame).
+  std::vector<double> predicted;
+  const double fx_baseline = keyframe_.camera.pinhole.fx * pair.baseline_m;
+  for (const auto& [id, p] : points) {
+    stereo.ids.push_back(id);
+    pixels.push_back(p);
+    const auto it = keyframe_.valid && predict ? keyframe_.points3d.find(id)
+                                               : keyframe_.points3d.end();
+    predicted.push_back(it != keyframe_.points3d.end() ? fx_baseline / it->second.z()
+                                                        : std::numeric_limits<double>::quiet_NaN());
+  }
+  stereo.matcher = std::make_unique<StereoMatcher>(pair.left, pair.right, std::move(pixels),
+                                                   pair.camera, pair.baseline_m, options_.stereo,
+                                                   std::move(predicted));
+  return stereo;
+}
+
+void VisualOdometry::complete_keyframe_stereo(const std::map<int64_t, Eigen::Vector2d>& tracked,
+                                              WorkClock* clock) {
+  std::map<int64_t, Eigen::Vector2d> late;
+  for (const int64_t id : keyframe_.stereo_pending)
+    if (tracked.count(id)) late[id] = keyframe_.points.at(id);
+  keyframe_.stereo_pending.clear();
+  if (late.empty() || !keyframe_.stereo.valid()) return;
+  // New features had no disparity to start from: no prediction, as when they were new.
+  const StereoFeatures stereo = stereo_features(keyframe_.stereo, late, false);
+  worker_->parallel_for(stereo.matcher->chunks(),
+                        clock->timed([&](int chunk) { stereo.matcher->search(chunk); }));
+  for (const auto& [id, X] : stereo.points()) keyframe_.points3d[id] = X;
+}
+
+void VisualOdometry::match_points(const std::map<int64_t, Eigen::Vector2d>& points,
+                                  const ImageFeatures& features, bool descriptors,
+                                  TwoViewMatches* m, std::vector<int64_t>* point_ids) const {
+  if (descriptors) {
+    std::vector<std::pair<int, int>> pairs;
+    m->points = match_point_features(keyframe_.features.points, features.points,
+                                     options_.features.points, &pairs);
+    for (const auto& p : pairs) point_ids->push_back(p.first);
+    return;
+  }
+  for (const auto& [id, p] : points) {
+    const auto it = keyframe_.points.find(id);
+    if (it == keyframe_.points.end()) continue;
+    m->points.push_back({it->second, p});
+    point_ids->push_back(id);
+  }
 }
 
 void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
                                    const std::map<int64_t, Eigen::Vector2d>& points,
                                    std::map<int64_t, Eigen::Vector3d> points3d,
-                                   ImageFeatures features, const std::vector<int64_t>& line_ids) {
+                                   ImageFeatures features, const std::vector<int64_t>& line_ids,
+                                   StereoPair stereo, std::vector<int64_t> pending) {
   keyframe_ = Keyframe();
   keyframe_.valid = true;
   keyframe_.stamp = input.stamp;
   keyframe_.points = points;
   keyframe_.points3d = std::move(points3d);
+  keyframe_.stereo = std::move(stereo);
+  keyframe_.stereo_pending = std::move(pending);
   for (size_t i = 0; i < line_ids.size() && i < features.lines.segments.size(); ++i)
     keyframe_.tracked_lines[line_ids[i]] = features.lines.segments[i];
   keyframe_.features = std::move(features);
@@ -177,10 +217,11 @@ void VisualOdometry::make_keyframe(const VisualOdometryInput& input, const cv::M
 std::vector<StereoScaleObservation> VisualOdometry::scale_observations(
     const VisualOdometryInput& input, const cv::Mat& gray, const TwoViewMatches& m,
     const std::vector<int64_t>& point_ids, const std::vector<char>& inliers,
-    const std::map<int64_t, Eigen::Vector2d>& points,
-    const std::map<int64_t, Eigen::Vector3d>& current3d, bool tracking) const {
+    const std::map<int64_t, Eigen::Vector2d>& points, bool tracking,
+    std::vector<int64_t>* observed) const {
   std::vector<StereoScaleObservation> observations;
-  std::vector<int64_t> ids;
+  std::vector<int64_t>& ids = *observed;
+  ids.clear();
   // The points were triangulated as Z = fx b / d.
   const double fx_baseline = keyframe_.camera.pinhole.fx * input.baseline_m;
   for (size_t i = 0; i < m.points.size() && i < point_ids.size(); ++i) {
@@ -191,20 +232,30 @@ std::vector<StereoScaleObservation> VisualOdometry::scale_observations(
     o.x_ref = keyframe_.camera.pinhole.normalize(m.points[i].x1);
     o.disparity_ref = fx_baseline / it->second.z();
     o.x_cur = input.camera.pinhole.normalize(m.points[i].x2);
-    const auto now = current3d.find(point_ids[i]);
-    if (options_.stereo_current_disparity && now != current3d.end())
-      o.disparity_cur = input.camera.pinhole.fx * input.baseline_m / now->second.z();
     observations.push_back(o);
     ids.push_back(point_ids[i]);
   }
   if (!tracking || !options_.stereo_refine_tracks || keyframe_.image.empty()) return observations;
-  return refine_scale_points(input, gray, points, ids, std::move(observations));
+  return refine_scale_points(input, gray, points, &ids, std::move(observations));
+}
+
+void VisualOdometry::add_current_disparities(
+    const VisualOdometryInput& input, const std::vector<int64_t>& ids,
+    const std::map<int64_t, Eigen::Vector3d>& current3d,
+    std::vector<StereoScaleObservation>* observations) const {
+  if (!options_.stereo_current_disparity) return;
+  const double fx_baseline = input.camera.pinhole.fx * input.baseline_m;
+  for (size_t k = 0; k < ids.size() && k < observations->size(); ++k) {
+    const auto now = current3d.find(ids[k]);
+    if (now != current3d.end()) (*observations)[k].disparity_cur = fx_baseline / now->second.z();
+  }
 }
 
 std::vector<StereoScaleObservation> VisualOdometry::refine_scale_points(
     const VisualOdometryInput& input, const cv::Mat& gray,
-    const std::map<int64_t, Eigen::Vector2d>& points, const std::vector<int64_t>& ids,
+    const std::map<int64_t, Eigen::Vector2d>& points, std::vector<int64_t>* observed,
     std::vector<StereoScaleObservation> observations) const {
+  const std::vector<int64_t>& ids = *observed;
   // Only the points that can scale the motion, nearer than the fit's depth limit with a margin
   // for the disparity offset: a farther point moves and grows little between frames (on the
   // rendered corridor the tracker's lag beyond 40 baselines is 0.001 px), and on a highway most
@@ -219,23 +270,19 @@ std::vector<StereoScaleObservation> VisualOdometry::refine_scale_points(
     from.push_back(keyframe_.points.at(ids[k]));
     to.push_back(points.at(ids[k]));
   }
-  // Half of them on the second core, idle once the stereo matching is done (each point is
-  // refined on its own: the same result either way).
-  const size_t split = from.size() / 2;
-  std::vector<Eigen::Vector2d> from_second(from.begin() + split, from.end());
-  std::vector<Eigen::Vector2d> to_second(to.begin() + split, to.end());
-  std::vector<char> refined_second;
-  WorkerJob second = worker_->submit([&] {
-    refined_second = refine_tracks_affine(keyframe_.image, gray, from_second, &to_second,
-                                          options_.stereo_track_refinement);
+  // On both threads, in chunks (each point is refined on its own: the same result either way).
+  constexpr int kChunk = 16;
+  const int n = static_cast<int>(from.size());
+  std::vector<char> refined(n, 0);
+  worker_->parallel_for((n + kChunk - 1) / kChunk, [&](int chunk) {
+    const int begin = chunk * kChunk, end = std::min(n, begin + kChunk);
+    const std::vector<Eigen::Vector2d> chunk_from(from.begin() + begin, from.begin() + end);
+    std::vector<Eigen::Vector2d> chunk_to(to.begin() + begin, to.begin() + end);
+    const std::vector<char> chunk_refined = refine_tracks_affine(
+        keyframe_.image, gray, chunk_from, &chunk_to, options_.stereo_track_refinement);
+    std::copy(chunk_to.begin(), chunk_to.end(), to.begin() + begin);
+    std::copy(chunk_refined.begin(), chunk_refined.end(), refined.begin() + begin);
   });
-  from.resize(split);
-  to.resize(split);
-  std::vector<char> refined =
-      refine_tracks_affine(keyframe_.image, gray, from, &to, options_.stereo_track_refinement);
-  second.get();
-  refined.insert(refined.end(), refined_second.begin(), refined_second.end());
-  to.insert(to.end(), to_second.begin(), to_second.end());
   // A track that cannot be refined is left out: on the corridor those lag by 0.57 px on
   // average, mostly windows at the image's border and lost tracks.
   std::vector<char> keep(observations.size(), 1);
@@ -246,12 +293,26 @@ std::vector<StereoScaleObservation> VisualOdometry::refine_scale_points(
           input.camera.has_distortion() ? input.camera.undistort(to[j]) : to[j]);
   }
   std::vector<StereoScaleObservation> kept;
-  for (size_t k = 0; k < observations.size(); ++k)
-    if (keep[k]) kept.push_back(observations[k]);
+  std::vector<int64_t> kept_ids;
+  for (size_t k = 0; k < observations.size(); ++k) {
+    if (!keep[k]) continue;
+    kept.push_back(observations[k]);
+    kept_ids.push_back(ids[k]);
+  }
+  *observed = std::move(kept_ids);
   return kept;
 }
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
+  const double caller_cpu_start = thread_cpu_ms(), worker_cpu_start = worker_->cpu_ms();
+  VisualOdometryResult r = run_frame(input);
+  // Each thread's CPU time for this frame: every job of the frame is done by now.
+  r.stages.caller_cpu_ms = thread_cpu_ms() - caller_cpu_start;
+  r.stages.worker_cpu_ms = worker_->cpu_ms() - worker_cpu_start;
+  return r;
+}
+
+VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input) {
   const auto start = std::chrono::steady_clock::now();
   VisualOdometryResult r;
   r.R_wc = R_wc_;
@@ -280,13 +341,30 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   const cv::Mat gray = to_gray8(input.image);
   StageTimings& times = r.stages;
 
-  // Features of this frame: the segments on the second thread while this one does the points.
+  // The second thread's queue, in order: the stereo pair's pyramids, the segments, then its share
+  // of the KLT searches and of the re-detection. This thread tracks the points meanwhile, then
+  // estimates while the second one re-detects; both match the stereo points at the end.
+  const bool tracking =
+      !input.external.has_points && options_.point_source == PointFeatureSource::kTracking;
+  const bool stereo = !input.right_image.empty() && input.baseline_m > 0.0;
+  // The KLT tracker's pyramid of this image serves the stereo matching when its window and
+  // levels suffice.
+  const bool klt_pyramid = tracking && options_.klt.window_px >= options_.stereo.window_px &&
+                           options_.klt.pyramid_levels >= options_.stereo.pyramid_levels;
+  StereoPair pair;
+  WorkerJob pyramids_job;
+  if (stereo) {
+    pair.camera = input.camera.pinhole;
+    pair.baseline_m = input.baseline_m;
+    pyramids_job = worker_->submit([&] {
+      pair.right = stereo_pyramid(to_gray8(input.right_image), options_.stereo);
+      if (!klt_pyramid) pair.left = stereo_pyramid(gray, options_.stereo);
+    });
+  }
   std::map<int64_t, Eigen::Vector2d> points;
   ImageFeatures features;
   std::vector<int64_t> line_ids;  // with track_lines: the track of each segment
-  WorkerJob lines_job, redetect_job;
-  const bool tracking =
-      !input.external.has_points && options_.point_source == PointFeatureSource::kTracking;
+  WorkerJob lines_job;
   if (options_.use_lines && !input.external.has_lines) {
     lines_job = worker_->submit([&] {
       const auto lines_start = std::chrono::steady_clock::now();
@@ -303,15 +381,10 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       if (all_finite(input.external.points[i]))
         points[input.external.point_ids[i]] = input.external.points[i];
   } else if (tracking) {
-    klt_.track_existing(gray, nullptr, input.stamp);
+    // The searches on both threads, the second once it has detected the segments.
+    klt_.track_existing(gray, nullptr, input.stamp, worker_->parallel());
     points = klt_points();
-    // The re-detection serves only the next frame: on the second thread after the segments,
-    // while this one matches and estimates. `points` holds the tracked features until then.
-    redetect_job = worker_->submit([&] {
-      const auto redetect_start = std::chrono::steady_clock::now();
-      klt_.detect_new();
-      times.redetect_ms = ms_since(redetect_start);
-    });
+    if (klt_pyramid) pair.left = klt_.pyramid();
   } else {
     features.points = detect_point_features(gray, options_.features.points);
     for (size_t i = 0; i < features.points.keypoints.size(); ++i)
@@ -319,32 +392,83 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
                                                         features.points.keypoints[i].pt.y);
   }
   times.points_ms = ms_since(points_start);
-  // Stereo matching of this frame's points (after the re-detection: the next keyframe needs them
-  // all), for the scale of this and the next motion: on the second thread while this one matches
-  // and estimates. Skipped when the frame turns out not to be kept before it starts.
-  std::map<int64_t, Eigen::Vector3d> points3d;
-  std::atomic<bool> skip_stereo{false};
-  WorkerJob stereo_job;
-  const bool stereo = !input.right_image.empty() && input.baseline_m > 0.0;
-  if (stereo) {
-    stereo_job = worker_->submit([&] {
-      if (skip_stereo) return;
-      const auto stereo_start = std::chrono::steady_clock::now();
-      // The KLT tracker's pyramid of this image serves when its window and levels suffice.
-      const bool reuse = tracking && options_.klt.window_px >= options_.stereo.window_px &&
-                         options_.klt.pyramid_levels >= options_.stereo.pyramid_levels;
-      points3d = stereo_of(input, gray, reuse ? &klt_.pyramid() : nullptr,
-                           tracking ? klt_points() : points);
-      times.stereo_ms = ms_since(stereo_start);
-    });
+
+  // Point matches keyframe -> current frame, and whether the frame moved enough to be estimated.
+  TwoViewMatches& m = r.matches;
+  std::vector<int64_t> point_ids;
+  if (keyframe_.valid)
+    match_points(points, features, !input.external.has_points && !tracking, &m, &point_ids);
+  const double parallax = m.points.size() >= 5 ? median_motion_px(m.points) : -1.0;
+  const bool low_parallax = parallax >= 0.0 && parallax < options_.min_parallax_px;
+
+  // Stereo points of this frame's features, for the scale of this and the next motion: started
+  // now, on the second thread while this one estimates, unless the frame is skipped (the few
+  // whose estimate fails are cancelled). KLT tracking matches its tracks and, first, the
+  // keyframe's new features tracked into this frame (Keyframe::stereo_pending); other points are
+  // matched at once.
+  const bool tracks = input.external.has_points || tracking;
+  WorkClock stereo_clock;
+  StereoFeatures current_stereo;
+  SharedLoop stereo_loop;
+  bool stereo_started = false;
+  auto start_stereo = [&] {
+    if (!stereo || stereo_started) return;
+    stereo_started = true;
+    pyramids_job.get();
+    if (tracking) complete_keyframe_stereo(points, &stereo_clock);
+    current_stereo = stereo_features(pair, points, tracks);
+    StereoMatcher& matcher = *current_stereo.matcher;
+    stereo_loop = worker_->share(matcher.chunks(),
+                                 stereo_clock.timed([&matcher](int c) { matcher.search(c); }));
+  };
+  auto match_stereo = [&] {
+    std::map<int64_t, Eigen::Vector3d> points3d;
+    if (!stereo) return points3d;
+    start_stereo();
+    stereo_loop.join();
+    times.stereo_ms = stereo_clock.ms();
+    return current_stereo.points();
+  };
+  if (!keyframe_.valid || !low_parallax) start_stereo();
+
+  // The re-detection serves only the next frame: cell by cell on the second thread while this
+  // one estimates and fits the scale, and this one takes the cells left when it is done.
+  // `points` holds the tracked features until then.
+  KltDetection detection;
+  SharedLoop redetection;
+  WorkClock redetect_clock;
+  if (tracking) {
+    detection = klt_.plan_detection();
+    redetection = worker_->share(detection.cells(), redetect_clock.timed([&](int cell) {
+      klt_.detect_cell(&detection, cell);
+    }));
   }
+  auto finish_redetection = [&] {
+    redetection.join();
+    if (tracking) klt_.add_detections(detection);
+    times.redetect_ms = redetect_clock.ms();
+  };
+  // The features that keyframe a frame: all the tracker holds once it has re-detected.
+  auto keep_as_keyframe = [&](std::map<int64_t, Eigen::Vector3d> points3d) {
+    finish_redetection();
+    std::vector<int64_t> pending;
+    if (tracking && stereo)
+      for (const int64_t id : klt_.ids())
+        if (!points.count(id)) pending.push_back(id);
+    make_keyframe(input, gray, tracking ? klt_points() : points, std::move(points3d),
+                  std::move(features), line_ids, std::move(pair), std::move(pending));
+  };
+  // A frame that is not kept: its stereo matching is left undone.
+  auto skip_frame = [&] {
+    stereo_loop.cancel();
+    finish_redetection();
+    r.total_ms = ms_since(start);
+    return r;
+  };
   lines_job.get();
 
   if (!keyframe_.valid) {
-    redetect_job.get();
-    stereo_job.get();
-    make_keyframe(input, gray, tracking ? klt_points() : points, std::move(points3d),
-                  std::move(features), line_ids);
+    keep_as_keyframe(match_stereo());
     r.status = was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
     r.message = was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
     r.reference_stamp = input.stamp;
@@ -353,26 +477,12 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   }
   r.reference_stamp = keyframe_.stamp;
 
-  // Matches keyframe -> current frame.
-  TwoViewMatches& m = r.matches;
-  std::vector<int64_t> point_ids;
-  if (!input.external.has_points && options_.point_source == PointFeatureSource::kDescriptors) {
-    std::vector<std::pair<int, int>> pairs;
-    m.points = match_point_features(keyframe_.features.points, features.points,
-                                    options_.features.points, &pairs);
-    for (const auto& p : pairs) point_ids.push_back(p.first);
-  } else {
-    for (const auto& [id, p] : points) {
-      const auto it = keyframe_.points.find(id);
-      if (it == keyframe_.points.end()) continue;
-      m.points.push_back({it->second, p});
-      point_ids.push_back(id);
-    }
-  }
+  // Segment matches keyframe -> current frame.
   if (input.external.has_lines) {
     for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i) {
       const auto it = keyframe_.external_lines.find(input.external.line_ids[i]);
-      if (it != keyframe_.external_lines.end()) m.lines.push_back({it->second, input.external.lines[i]});
+      if (it != keyframe_.external_lines.end())
+        m.lines.push_back({it->second, input.external.lines[i]});
     }
   } else if (options_.use_lines) {
     const auto matching_start = std::chrono::steady_clock::now();
@@ -394,29 +504,17 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
 
   if (r.num_point_matches < options_.min_point_matches &&
       r.num_line_matches < options_.min_line_matches) {
-    redetect_job.get();
-    stereo_job.get();
-    make_keyframe(input, gray, tracking ? klt_points() : points, std::move(points3d),
-                  std::move(features), line_ids);
+    keep_as_keyframe(match_stereo());
     r.status = VoStatus::kTooFewFeatures;
     r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
     r.total_ms = ms_since(start);
     return r;
   }
-  if (r.num_point_matches >= 5) {
-    std::vector<double> motion;
-    for (const PointMatch& p : m.points) motion.push_back((p.x2 - p.x1).norm());
-    std::nth_element(motion.begin(), motion.begin() + motion.size() / 2, motion.end());
-    if (motion[motion.size() / 2] < options_.min_parallax_px) {
-      r.status = VoStatus::kLowParallax;
-      r.message = "median motion " + std::to_string(motion[motion.size() / 2]) + " px";
-      skip_stereo = true;
-      stereo_job.wait();
-      redetect_job.get();
-      r.total_ms = ms_since(start);
-      return r;
-    }
+  if (low_parallax) {
+    r.status = VoStatus::kLowParallax;
+    r.message = "median motion " + std::to_string(parallax) + " px";
+    return skip_frame();
   }
 
   // Estimation: VPs detected jointly, refined by the tracker, then the hybrid RANSAC.
@@ -473,16 +571,22 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   if (est.status != EstimationStatus::kOk) {
     r.status = VoStatus::kNoPose;
     r.message = std::string("estimator: ") + hybrid_vo::to_string(est.status);
-    skip_stereo = true;
-    stereo_job.wait();
-    redetect_job.get();
-    r.total_ms = ms_since(start);
-    return r;
+    return skip_frame();
   }
 
   // Orientation: the pair's rotation, anchored by the VP tracks it sees (VpTracker::anchor).
-  redetect_job.get();
-  stereo_job.get();
+  // The scale's observations, their current points refined on this thread while the second one
+  // still matches the stereo points (then it re-detects while this one fits the scale); then
+  // this frame's disparities.
+  std::vector<StereoScaleObservation> observations;
+  std::vector<int64_t> observed;
+  const auto refine_start = std::chrono::steady_clock::now();
+  if (stereo)
+    observations = scale_observations(input, gray, m, point_ids, est.point_inliers, points,
+                                      tracking, &observed);
+  times.scale_ms = ms_since(refine_start);
+  std::map<int64_t, Eigen::Vector3d> current3d = match_stereo();
+  if (stereo) add_current_disparities(input, observed, current3d, &observations);
   RelativePose pose = est.pose;
   std::vector<VpObservation> seen;  // the VPs the pose accepts, as seen in image 2
   if (options_.use_vp_tracker) {
@@ -525,14 +629,12 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   // Scale: the keyframe's stereo points seen again, with this frame's disparities, fitted in
   // disparity and image space (estimate_stereo_scale); without a usable fit, the configured
   // length and scale_known false.
-  std::map<int64_t, Eigen::Vector3d> current3d = std::move(points3d);
   r.motion = pose;
   double scale = options_.mono_scale, scale_sigma = 0.0;
   if (stereo) {
     r.stereo_scale_attempted = true;
     const auto scale_start = std::chrono::steady_clock::now();
-    r.scale_observations = scale_observations(input, gray, m, point_ids, est.point_inliers,
-                                              points, current3d, tracking);
+    r.scale_observations = std::move(observations);
     const StereoRig rig{input.camera.pinhole.fx, input.camera.pinhole.fy, input.baseline_m};
     // The pair's own pose: its rotation and translation explain its points together, and the
     // scale is fitted to those points (with the anchored rotation the demo's ATE was 0.0135 m
@@ -546,7 +648,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
       scale_sigma = r.stereo_scale.sigma;
       r.scale_known = true;
     }
-    times.scale_ms = ms_since(scale_start);
+    times.scale_ms += ms_since(scale_start);
   }
   r.motion.t = pose.t * scale;
   if (est.covariance_valid) {
@@ -566,8 +668,7 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   r.centre = centre_;
   // Every estimated frame, also without VPs, so that misses count.
   if (options_.use_vp_tracker) r.vp_associations = vp_tracker_.update(R_wc_, seen);
-  make_keyframe(input, gray, tracking ? klt_points() : points, std::move(current3d),
-                std::move(features), line_ids);
+  keep_as_keyframe(std::move(current3d));
   r.status = VoStatus::kOk;
   r.message = "ok";
   r.total_ms = ms_since(start);

@@ -6,6 +6,7 @@
 #include <hybrid_vo/MotionEstimate.h>
 #include <hybrid_vo/VanishingPoints.h>
 #include <nav_msgs/Odometry.h>
+#include <opencv2/core/utility.hpp>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "hybrid_vo/node/compressed_image.h"
@@ -86,6 +87,9 @@ void VoNode::load_parameters() {
   for (const std::string& warning : warnings) ROS_WARN("hybrid_vo: %s", warning.c_str());
   left_rectifier_ = right_rectifier_ = FisheyeRectifier(params_.rectified_fov_deg);
   monitor_ = StreamMonitor(params_.stream);
+  // A pool beside the front end's two threads only contends for the same cores and splits each
+  // small search into stripes (on KITTI 10 % more instructions).
+  if (params_.opencv_threads >= 0) cv::setNumThreads(params_.opencv_threads);
 }
 
 void VoNode::run() {

@@ -122,6 +122,8 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("VPs (ms)", r.stages.vps_ms);
   status.add("RANSAC (ms)", r.stages.ransac_ms);
   status.add("stereo (ms)", r.stages.stereo_ms);
+  status.add("CPU, processing thread (ms)", r.stages.caller_cpu_ms);
+  status.add("CPU, front end's second thread (ms)", r.stages.worker_cpu_ms);
   status.add("segment tracks found", r.line_tracking.matched);
   status.add("segment tracks started", r.line_tracking.started);
 }

@@ -19,6 +19,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "hybrid_vo/datasets/kitti.h"
@@ -38,13 +39,18 @@ void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
-               " [--no-anchor] [--no-vp-tracker] [--seed S] [--verbose]\n"
+               " [--drop-leaving] [--no-anchor] [--no-vp-tracker] [--seed S] [--opencv-threads N]"
+               " [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
-               "  the KLT corners' strength floor (0: every corner); --no-anchor: no orientation\n"
+               "  the KLT corners' strength floor (0: every corner); --drop-leaving: KLT drops\n"
+               "  the features predicted outside the image unsearched; --no-anchor: no orientation\n"
                "  anchoring by the VP tracks. Default preset hybrid+junc.\n"
+               "  --opencv-threads N: OpenCV's own thread pool (cv::setNumThreads), as the node's\n"
+               "  opencv_threads parameter; default 1 (none: the front end splits its work over\n"
+               "  its two threads itself); -1 leaves OpenCV's default.\n"
                "  --trajectory: every frame's camera pose in the odometry frame, TUM format\n"
                "  (timestamp tx ty tz qx qy qz qw; stamps from times.txt + 1 s, as kitti_to_bag\n"
                "  writes them).\n"
@@ -138,6 +144,7 @@ int run(int argc, char** argv) {
   int vp_min_inliers = 6;
   std::string trajectory_path;
   int direct_gap = 0;
+  int opencv_threads = 1;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -148,6 +155,7 @@ int run(int argc, char** argv) {
     else if (a == "--min-corner-gradient" && i + 1 < argc)
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--no-predict") o.klt.predict_motion = false;
+    else if (a == "--drop-leaving") o.klt.drop_leaving = true;
     else if (a == "--stereo") stereo = true;
     else if (a == "--klt-window" && i + 1 < argc) o.klt.window_px = std::atoi(argv[++i]);
     else if (a == "--klt-iterations" && i + 1 < argc) o.klt.max_iterations = std::atoi(argv[++i]);
@@ -155,6 +163,7 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--no-anchor") o.anchor_orientation = false;
+    else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
     else if (a == "--direct-gap" && i + 1 < argc) {
@@ -164,6 +173,7 @@ int run(int argc, char** argv) {
         return 2;
       }
     }
+    else if (a == "--opencv-threads" && i + 1 < argc) opencv_threads = std::atoi(argv[++i]);
     else if (a == "--seed" && i + 1 < argc)
       o.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
@@ -179,6 +189,8 @@ int run(int argc, char** argv) {
       return 2;
     }
   }
+  // As the node does (its opencv_threads parameter).
+  if (opencv_threads >= 0) cv::setNumThreads(opencv_threads);
   if (!preset_options(preset, &o.estimator)) {
     std::cerr << "unknown preset " << preset << "\n";
     return 2;
@@ -255,8 +267,8 @@ int run(int argc, char** argv) {
 
   VisualOdometry vo(o);
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
-      stereo_ms, scaled, cpu, line_matches, line_inliers, tracked, started, junctions,
-      junction_inliers, vp_matches, vp_inliers;
+      stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
+      tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0;
   double lines_sum = 0.0, inliers_sum = 0.0;
   const auto run_start = std::chrono::steady_clock::now();
@@ -372,6 +384,9 @@ int run(int argc, char** argv) {
     }
     if (i == 0) continue;  // the first frame only initialises
     cpu.push_back(cpu_ms() - cpu_start);
+    caller_cpu.push_back(r.stages.caller_cpu_ms);
+    worker_cpu.push_back(r.stages.worker_cpu_ms);
+    longest_cpu.push_back(std::max(r.stages.caller_cpu_ms, r.stages.worker_cpu_ms));
     total.push_back(r.total_ms);
     frontend.push_back(r.frontend_ms);
     estimator.push_back(r.estimator_ms);
@@ -405,6 +420,10 @@ int run(int argc, char** argv) {
               "line matching %.1f, VPs %.1f, RANSAC %.1f; CPU per frame %.1f\n",
               median(total), median(frontend), median(estimator), median(points), median(redetect),
               median(lines), median(matching), median(vps), median(ransac), median(cpu));
+  // What a machine's speed decides, whatever else runs on it: the frame cannot take less than
+  // its longer thread's CPU time.
+  std::printf("CPU ms per frame (median) by thread: calling %.1f, worker %.1f, the longer %.1f\n",
+              median(caller_cpu), median(worker_cpu), median(longest_cpu));
   if (stereo) {
     double n = 0.0;
     for (double s : scaled) n += s;

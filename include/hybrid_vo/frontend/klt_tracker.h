@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/frontend/worker_thread.h"
 #include "hybrid_vo/geometry/option_fields.h"
 
 namespace hybrid_vo {
@@ -42,6 +43,24 @@ struct KltTrackerOptions {
   // does not start the short search at half the true motion (up to kMaxMotionScale).
   bool predict_motion = true;
   int predicted_pyramid_levels = 1;
+  // Whether a feature predicted to lie outside the image is dropped without a search. On KITTI
+  // 130 features a frame are, and searching them costs 8 % of the front end's instructions for
+  // the same accuracy; but where the prediction overshoots (a corridor's turns) the search finds
+  // them inside again, and dropping them costs accuracy (rendered corridors 1.3-1.7 -> 1.6-2.2
+  // deg/100 m; doc/performance.md). So off by default.
+  bool drop_leaving = false;
+};
+
+// Re-detection's work, cell by cell (KltTracker::plan_detection, detect_cell, add_detections).
+struct KltDetection {
+  int cols = 1, rows = 1, cell_w = 1, cell_h = 1;
+  std::vector<int> wanted;  // per cell: the corners to look for (its quota minus its tracks)
+  cv::Mat mask;             // 0 within min_distance_px of a tracked feature
+  // Per cell: its corners, strongest first (image pixels), and whether each is strong enough
+  // (min_corner_gradient).
+  std::vector<std::vector<cv::Point2f>> corners;
+  std::vector<std::vector<char>> strong;
+  int cells() const { return cols * rows; }
 };
 
 template <typename Visit>
@@ -52,11 +71,13 @@ void visit_fields(KltTrackerOptions& o, Visit&& visit) {
                   o.predicted_pyramid_levels);
   HYBRID_VO_FIELDS(positive_fraction(), o.quality_level);
   HYBRID_VO_FIELDS(at_least(5), o.window_px);  // smaller windows lose the texture
-  HYBRID_VO_FIELDS(any_value(), o.predict_motion);
+  HYBRID_VO_FIELDS(any_value(), o.predict_motion, o.drop_leaving);
 }
 
 // Sparse optical-flow tracking of corners between consecutive video frames, with re-detection in
-// empty buckets; each feature keeps a stable id across frames.
+// empty buckets; each feature keeps a stable id across frames. Each feature is searched for on its
+// own and each bucket filled on its own, so `parallel` (worker_thread.h) may spread both over
+// threads: the tracks are the same either way.
 class KltTracker {
  public:
   static constexpr double kNoStamp = std::numeric_limits<double>::quiet_NaN();
@@ -71,13 +92,21 @@ class KltTracker {
   // track ids. The first call (or the first after reset) returns no matches. `stamp` (seconds,
   // optional) scales the motion prediction when frames are not evenly spaced.
   std::vector<PointMatch> track(const cv::Mat& image, std::vector<int64_t>* ids = nullptr,
-                                double stamp = kNoStamp);
+                                double stamp = kNoStamp, const ParallelFor& parallel = {});
   // The two halves of track, so that the re-detection, which only the next frame needs, can run
   // while the caller uses the matches. After track_existing, points() holds the tracked features.
   std::vector<PointMatch> track_existing(const cv::Mat& image, std::vector<int64_t>* ids = nullptr,
-                                         double stamp = kNoStamp);
+                                         double stamp = kNoStamp,
+                                         const ParallelFor& parallel = {});
   // Fills the buckets of the last tracked image that have too few features; appends to points().
-  void detect_new();
+  void detect_new(const ParallelFor& parallel = {});
+  // detect_new in three steps, so that a caller can run the cells beside other work: the grid,
+  // quotas and mask of the tracked features; the corners of one cell (cells are independent,
+  // and detect_cell changes nothing but its own cell of `detection`); and their admission in
+  // cell order up to max_features. Nothing may change the tracker in between.
+  KltDetection plan_detection() const;
+  void detect_cell(KltDetection* detection, int cell) const;
+  void add_detections(const KltDetection& detection);
   void reset();
   int num_tracks() const;
   // Every feature of the last frame (tracked and newly detected) and its id.
@@ -94,6 +123,10 @@ class KltTracker {
   // Ratio of the time since the last frame to the time step its motions were measured over; 1
   // without stamps.
   double motion_scale(double stamp) const;
+  // The searches of features [begin, end) into `pyramid` (see track_existing); writes only their
+  // slots of `search`.
+  struct Search;
+  void search_range(const std::vector<cv::Mat>& pyramid, int begin, int end, Search* search) const;
 
   KltTrackerOptions options_;
   int max_features_;

@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/frontend/camera_model.h"
+#include "hybrid_vo/frontend/worker_thread.h"
 #include "hybrid_vo/geometry/pose.h"
 
 namespace hybrid_vo {
@@ -45,15 +46,51 @@ std::vector<Eigen::Vector3d> stereo_points(const cv::Mat& left, const cv::Mat& r
                                            const StereoOptions& options = {},
                                            const std::vector<double>& predicted_disparities = {});
 
-// The same with the left image's pyramid already built (cv::buildOpticalFlowPyramid with
-// derivatives, a window of at least options.window_px and options.pyramid_levels levels), such as
-// the KLT tracker's: the video front end then builds only the right image's.
+// An image's pyramid as stereo_points searches it: cv::buildOpticalFlowPyramid with derivatives,
+// options.window_px and options.pyramid_levels.
+std::vector<cv::Mat> stereo_pyramid(const cv::Mat& image, const StereoOptions& options = {});
+
+// The same with both images' pyramids already built (as stereo_pyramid builds them, or with a
+// larger window or more levels), such as the KLT tracker's of the left image: the video front
+// end builds each pyramid once. Each point is searched for on its own, so `parallel` may spread
+// the points over threads: the result is the same.
 std::vector<Eigen::Vector3d> stereo_points(const std::vector<cv::Mat>& left_pyramid,
-                                           const cv::Mat& right,
+                                           const std::vector<cv::Mat>& right_pyramid,
                                            const std::vector<Eigen::Vector2d>& pixels,
                                            const PinholeCamera& camera, double baseline_m,
                                            std::vector<char>* valid,
                                            const StereoOptions& options = {},
-                                           const std::vector<double>& predicted_disparities = {});
+                                           const std::vector<double>& predicted_disparities = {},
+                                           const ParallelFor& parallel = {});
+
+// stereo_points in steps, so that a caller can run the searches beside other work: the points
+// are searched for in chunks, each chunk on its own (search touches nothing else), on any
+// threads and in any order; points() then triangulates them. The result is stereo_points'.
+class StereoMatcher {
+ public:
+  StereoMatcher(std::vector<cv::Mat> left_pyramid, std::vector<cv::Mat> right_pyramid,
+                std::vector<Eigen::Vector2d> pixels, const PinholeCamera& camera,
+                double baseline_m, const StereoOptions& options = {},
+                std::vector<double> predicted_disparities = {});
+  int chunks() const;
+  void search(int chunk);
+  std::vector<Eigen::Vector3d> points(std::vector<char>* valid) const;
+
+ private:
+  static constexpr int kChunk = 32;  // points per chunk: fine enough for two threads to share
+
+  std::vector<cv::Mat> left_, right_;
+  std::vector<Eigen::Vector2d> pixels_;
+  PinholeCamera camera_;
+  double baseline_m_ = 0.0;
+  StereoOptions options_;
+  std::vector<double> predicted_;  // empty or one per point
+  bool usable_ = false;            // inputs that can give points at all
+  double start_ = 0.0;             // the long way's offset (pixels)
+  // Per point: the left pixel, the right match, the way back, the search's offset and outcome.
+  std::vector<cv::Point2f> from_, to_, back_;
+  std::vector<float> offset_;
+  std::vector<char> found_, back_found_, long_way_;
+};
 
 }  // namespace hybrid_vo

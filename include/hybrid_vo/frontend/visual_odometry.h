@@ -171,6 +171,15 @@ class VisualOdometry {
   const VisualOdometryOptions& options() const { return options_; }
 
  private:
+  // A frame's stereo pair as LK pyramids (stereo_pyramid), each image's built once: the left one
+  // is the KLT tracker's when it serves.
+  struct StereoPair {
+    std::vector<cv::Mat> left, right;
+    PinholeCamera camera;
+    double baseline_m = 0.0;
+    bool valid() const { return !left.empty() && !right.empty(); }
+  };
+
   struct Keyframe {
     bool valid = false;
     double stamp = 0.0;
@@ -182,36 +191,68 @@ class VisualOdometry {
     bool points_undistorted = false, lines_undistorted = false;
     CameraModel camera;
     cv::Mat image;  // grey, kept for the scale's track refinement (stereo input only)
+    // KLT tracking with stereo: the features new in this frame get their stereo points only once
+    // they are tracked into a later frame (complete_keyframe_stereo), from this pair: on KITTI
+    // two thirds of them are lost at their first track. The points are those an eager match
+    // would give, a new feature having no disparity to start its search from either way.
+    StereoPair stereo;
+    std::vector<int64_t> stereo_pending;
     Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d R_wc_covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   };
 
-  // Stereo points of the frame's features by id (empty without a right image). `left_pyramid`,
-  // when not null, is the left image's LK pyramid (the KLT tracker's).
-  std::map<int64_t, Eigen::Vector3d> stereo_of(const VisualOdometryInput& input,
-                                               const cv::Mat& gray,
-                                               const std::vector<cv::Mat>* left_pyramid,
-                                               const std::map<int64_t, Eigen::Vector2d>& points) const;
+  // The stereo matching of features by id (the searches are left to the caller).
+  struct StereoFeatures {
+    std::vector<int64_t> ids;
+    std::unique_ptr<StereoMatcher> matcher;
+    std::map<int64_t, Eigen::Vector3d> points() const;  // once every chunk is searched
+  };
+  // Of `points` (by id) in `pair`. With `predict` each search starts at the disparity of the
+  // same id in the keyframe, when it has one.
+  StereoFeatures stereo_features(const StereoPair& pair,
+                                 const std::map<int64_t, Eigen::Vector2d>& points,
+                                 bool predict) const;
+  // The keyframe's pending stereo points of the features among `tracked`, on both threads
+  // (timed by `clock`); the others can never be matched again, and leave the pending list.
+  void complete_keyframe_stereo(const std::map<int64_t, Eigen::Vector2d>& tracked,
+                                WorkClock* clock);
+  // Point matches keyframe -> current frame (pixels) and their ids: by track id, or by
+  // descriptor (`descriptors`, ids are keyframe indices).
+  void match_points(const std::map<int64_t, Eigen::Vector2d>& points,
+                    const ImageFeatures& features, bool descriptors, TwoViewMatches* m,
+                    std::vector<int64_t>* point_ids) const;
+  // `points3d` are the stereo points of `points` matched so far; `pending` the ids still
+  // without (see Keyframe::stereo_pending).
   void make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
                      const std::map<int64_t, Eigen::Vector2d>& points,
                      std::map<int64_t, Eigen::Vector3d> points3d, ImageFeatures features,
-                     const std::vector<int64_t>& line_ids);
+                     const std::vector<int64_t>& line_ids, StereoPair stereo,
+                     std::vector<int64_t> pending);
+
+  // process() without the threads' CPU times (not named process*: callgrind's
+  // --toggle-collect='hybrid_vo::VisualOdometry::process*' would toggle twice).
+  VisualOdometryResult run_frame(const VisualOdometryInput& input);
 
   // The scale's observations of an estimated pair: the keyframe's stereo points among the
-  // pose's point inliers, seen again (with their current disparities when known).
+  // pose's point inliers, seen again; `observed` receives their ids.
   std::vector<StereoScaleObservation> scale_observations(
       const VisualOdometryInput& input, const cv::Mat& gray, const TwoViewMatches& m,
       const std::vector<int64_t>& point_ids, const std::vector<char>& inliers,
-      const std::map<int64_t, Eigen::Vector2d>& points,
-      const std::map<int64_t, Eigen::Vector3d>& current3d, bool tracking) const;
-  // Their current points (of KLT tracks `ids`, at `points` in this frame) re-tracked from the
-  // keyframe with an affine window (refine_tracks_affine); the near ones that cannot be are
-  // left out.
+      const std::map<int64_t, Eigen::Vector2d>& points, bool tracking,
+      std::vector<int64_t>* observed) const;
+  // Their current points (of KLT tracks `observed`, at `points` in this frame) re-tracked from
+  // the keyframe with an affine window (refine_tracks_affine), on both threads; the near ones
+  // that cannot be are left out (of `observed` too).
   std::vector<StereoScaleObservation> refine_scale_points(
       const VisualOdometryInput& input, const cv::Mat& gray,
-      const std::map<int64_t, Eigen::Vector2d>& points, const std::vector<int64_t>& ids,
+      const std::map<int64_t, Eigen::Vector2d>& points, std::vector<int64_t>* observed,
       std::vector<StereoScaleObservation> observations) const;
+  // This frame's disparities of the observations of `ids` (stereo_current_disparity), where
+  // `current3d` has them.
+  void add_current_disparities(const VisualOdometryInput& input, const std::vector<int64_t>& ids,
+                               const std::map<int64_t, Eigen::Vector3d>& current3d,
+                               std::vector<StereoScaleObservation>* observations) const;
 
   // Every feature the KLT tracker holds, by id.
   std::map<int64_t, Eigen::Vector2d> klt_points() const;

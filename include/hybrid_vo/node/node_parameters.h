@@ -30,6 +30,9 @@ struct NodeParameters {
   double min_frequency = 1.0, max_frequency = 100.0;
   int frame_queue_size = 1;
   int path_max_poses = 5000;
+  // OpenCV's own thread pool for the process (cv::setNumThreads); < 0 leaves OpenCV's default.
+  // 1: none, since the front end splits its work over its two threads itself (doc/performance.md).
+  int opencv_threads = 1;
   StreamMonitorOptions stream;
   // The choices as read, for the start-up log line.
   std::string preset = "hybrid", points = "klt", lines = "fld";
