@@ -57,21 +57,22 @@ std::vector<T> rows_of(const RowMatrix& m, Row row) {
   return out;
 }
 
-Eigen::Vector4d segment_row(const LineSegment& s) {
-  return {s.p1.x(), s.p1.y(), s.p2.x(), s.p2.y()};
-}
-
 }  // namespace
 
 void throw_value_error(const std::string& argument, const std::string& message) {
   throw py::value_error(argument + ": " + message);
 }
 
-void check_same_rows(size_t other_rows, const std::string& other, size_t rows,
-                     const std::string& name) {
-  if (rows != other_rows)
-    throw_value_error(
-        name, std::to_string(rows) + " rows, but " + other + " has " + std::to_string(other_rows));
+void check_array(const py::array& a, const std::string& name, bool dtype_ok,
+                 const std::string& dtype, bool shape_ok, const std::string& shape) {
+  if (!dtype_ok)
+    throw_value_error(name, "dtype " + std::string(py::str(a.dtype())) + ", expected " + dtype);
+  if (!shape_ok) throw_value_error(name, "shape " + shape_text(a) + ", expected " + shape);
+  if (!(a.flags() & py::array::c_style))
+    throw_value_error(name,
+                      "not C-contiguous (a strided view or a transpose); pass "
+                      "np.ascontiguousarray(" +
+                          name + ")");
 }
 
 RowMatrix matrix_argument(py::handle value, const std::string& name, py::ssize_t cols,
@@ -87,32 +88,19 @@ RowMatrix matrix_argument(py::handle value, const std::string& name, py::ssize_t
           name, "expected numbers, got elements of dtype " + std::string(py::str(a.dtype())));
     a = numpy().attr("ascontiguousarray")(a, "dtype"_a = "float64");
   }
-  if (!py::isinstance<py::array_t<double>>(a))
-    throw_value_error(name, "dtype " + std::string(py::str(a.dtype())) + ", expected float64 (" +
-                                "np.ascontiguousarray(" + name +
-                                ", dtype=np.float64) converts it)");
   const bool vector_form = rows == 1 && a.ndim() == 1 && a.shape(0) == cols;
   const bool matrix_form = a.ndim() == 2 && a.shape(1) == cols && (rows < 0 || a.shape(0) == rows);
-  if (!vector_form && !matrix_form)
-    throw_value_error(name, "shape " + shape_text(a) + ", expected " + expected_shape(rows, cols));
-  if (!(a.flags() & py::array::c_style))
-    throw_value_error(name,
-                      "not C-contiguous (a strided view or a transpose); pass "
-                      "np.ascontiguousarray(" +
-                          name + ")");
+  check_array(a, name, py::isinstance<py::array_t<double>>(a),
+              "float64 (np.ascontiguousarray(" + name + ", dtype=np.float64) converts it)",
+              vector_form || matrix_form, expected_shape(rows, cols));
   const RowMatrix m = Eigen::Map<const RowMatrix>(static_cast<const double*>(a.data()),
                                                   vector_form ? 1 : a.shape(0), cols);
-  const bool finite = m.allFinite();
-  for (Eigen::Index k = 0; !finite && k < m.size(); ++k) {  // name the first value that is not
-    const Eigen::Index i = k / cols, j = k % cols;
-    if (std::isfinite(m(i, j))) continue;
-    const std::string where = vector_form
-                                  ? "[" + std::to_string(j) + "]"
-                                  : "[" + std::to_string(i) + ", " + std::to_string(j) + "]";
-    throw_value_error(name, "value " + where + " is not finite (" +
-                                std::string(py::str(py::float_(m(i, j)))) + ")");
-  }
-  return m;
+  if (m.allFinite()) return m;
+  Eigen::Index k = 0;  // name the first value that is not finite
+  while (std::isfinite(m.data()[k])) ++k;
+  const std::string row = vector_form ? "" : std::to_string(k / cols) + ", ";
+  throw_value_error(name, "value [" + row + std::to_string(k % cols) + "] is not finite (" +
+                              std::string(py::str(py::float_(m.data()[k]))) + ")");
 }
 
 std::vector<Eigen::Vector2d> points_argument(py::handle value, const std::string& name,
@@ -174,16 +162,10 @@ long long integer_argument(py::handle value, const std::string& name) {
 }
 
 std::vector<int> labels_argument(py::handle value, const std::string& name) {
-  const std::string expected = "a 1-D integer array";
-  const bool converted = !py::isinstance<py::array>(value);
-  py::array a = as_array(value, name, expected);
+  const py::array a = as_array(value, name, "a 1-D integer array");
+  const bool empty_list = !py::isinstance<py::array>(value) && a.size() == 0;
   const char kind = a.dtype().kind();
-  const bool empty_list = converted && a.size() == 0;
-  if (!empty_list && kind != 'i' && kind != 'u')
-    throw_value_error(name, "dtype " + std::string(py::str(a.dtype())) + ", expected integers");
-  if (a.ndim() != 1) throw_value_error(name, "shape " + shape_text(a) + ", expected (N,)");
-  if (!(a.flags() & py::array::c_style))
-    throw_value_error(name, "not contiguous; pass np.ascontiguousarray(" + name + ")");
+  check_array(a, name, empty_list || kind == 'i' || kind == 'u', "integers", a.ndim() == 1, "(N,)");
   const auto values = py::array_t<int64_t, py::array::forcecast>::ensure(a);
   std::vector<int> out(static_cast<size_t>(a.size()));
   for (py::ssize_t i = 0; i < a.size(); ++i) {
@@ -265,49 +247,25 @@ py::dict camera_to_dict(const PinholeCamera& camera) {
                   "width"_a = camera.width, "height"_a = camera.height);
 }
 
-py::array_t<int64_t> to_int_array(const std::vector<int>& values) {
-  py::array_t<int64_t> a(static_cast<py::ssize_t>(values.size()));
-  std::copy(values.begin(), values.end(), a.mutable_data());
-  return a;
-}
-
-py::array_t<double> points_to_array(const std::vector<Eigen::Vector2d>& points) {
-  return rows_to_array<double, 2>(points, [](const Eigen::Vector2d& p) { return p; });
-}
-
-py::array_t<double> segments_to_array(const std::vector<LineSegment>& segments) {
-  return rows_to_array<double, 4>(segments, segment_row);
-}
-
-py::array_t<double> directions_to_array(const std::vector<Eigen::Vector3d>& directions) {
-  return rows_to_array<double, 3>(directions, [](const Eigen::Vector3d& d) { return d; });
-}
-
 py::tuple pose_to_tuple(const RelativePose& pose) {
   return py::make_tuple(to_array(pose.R), to_array(pose.t));
 }
 
-py::dict matches_to_dict(const TwoViewMatches& matches) {
-  auto points = [&](Eigen::Vector2d PointMatch::*x) {
-    return rows_to_array<double, 2>(matches.points, [x](const PointMatch& m) { return m.*x; });
-  };
-  auto segments = [&](LineSegment LineMatch::*s) {
-    return rows_to_array<double, 4>(matches.lines,
-                                    [s](const LineMatch& m) { return segment_row(m.*s); });
-  };
-  return py::dict("points1"_a = points(&PointMatch::x1), "points2"_a = points(&PointMatch::x2),
-                  "segments1"_a = segments(&LineMatch::s1),
-                  "segments2"_a = segments(&LineMatch::s2));
+py::dict matches_to_dict(const TwoViewMatches& m) {
+  return py::dict(
+      "points1"_a = rows_to_array<double, 2>(m.points, [](const PointMatch& p) { return p.x1; }),
+      "points2"_a = rows_to_array<double, 2>(m.points, [](const PointMatch& p) { return p.x2; }),
+      "segments1"_a = rows_to_array<double, 4>(m.lines, [](auto& l) { return segment_row(l.s1); }),
+      "segments2"_a = rows_to_array<double, 4>(m.lines, [](auto& l) { return segment_row(l.s2); }));
 }
 
 py::dict vps_to_dict(const std::vector<VpMatch>& vps) {
-  auto directions = [&](Eigen::Vector3d VpMatch::*d) {
-    return rows_to_array<double, 3>(vps, [d](const VpMatch& vp) { return vp.*d; });
-  };
   std::vector<char> known;
   for (const VpMatch& vp : vps) known.push_back(vp.sign_known);
-  return py::dict("vps"_a = py::make_tuple(directions(&VpMatch::d1), directions(&VpMatch::d2)),
-                  "vp_signs_known"_a = to_bool_array(known));
+  return py::dict("vps"_a = py::make_tuple(
+                      rows_to_array<double, 3>(vps, [](const VpMatch& vp) { return vp.d1; }),
+                      rows_to_array<double, 3>(vps, [](const VpMatch& vp) { return vp.d2; })),
+                  "vp_signs_known"_a = array_of<bool>(known));
 }
 
 }  // namespace hybrid_vo::python

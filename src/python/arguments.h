@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,9 +24,10 @@ namespace hybrid_vo::python {
 namespace py = pybind11;
 
 [[noreturn]] void throw_value_error(const std::string& argument, const std::string& message);
-// "name: 39 rows, but other has 40" unless the row counts agree.
-void check_same_rows(size_t other_rows, const std::string& other, size_t rows,
-                     const std::string& name);
+
+// ValueError naming `name` unless `a` has the expected dtype and shape and is C-contiguous.
+void check_array(const py::array& a, const std::string& name, bool dtype_ok,
+                 const std::string& dtype, bool shape_ok = true, const std::string& shape = "");
 
 // A validated rows x cols float64 array argument, copied. NumPy arrays must already be float64
 // and C-contiguous: the bindings refuse rather than copy a strided view or round a float32 behind
@@ -44,6 +46,25 @@ std::vector<LineSegment> segments_argument(py::handle value, const std::string& 
                                            py::ssize_t rows = kAnyRows);
 std::vector<Eigen::Vector3d> directions_argument(py::handle value, const std::string& name,
                                                  py::ssize_t rows = kAnyRows);
+// Matches {first[i], second[i]} (PointMatch, LineMatch, VpMatch) of two arguments, each read by
+// `read` (one of the three above); ValueError unless both have the same rows. With `optional`,
+// both None are no matches, and one None is a ValueError.
+template <typename Match, typename Read>
+std::vector<Match> matches_argument(py::handle first, py::handle second, const std::string& name1,
+                                    const std::string& name2, Read read, bool optional = false) {
+  if (optional && first.is_none() != second.is_none())
+    throw_value_error(
+        first.is_none() ? name1 : name2,
+        "None while " + (first.is_none() ? name2 : name1) + " is given (pass both or neither)");
+  if (optional && first.is_none()) return {};
+  const auto a = read(first, name1, kAnyRows), b = read(second, name2, kAnyRows);
+  if (a.size() != b.size())
+    throw_value_error(name2, std::to_string(b.size()) + " rows, but " + name1 + " has " +
+                                 std::to_string(a.size()));
+  std::vector<Match> out(a.size());
+  for (size_t i = 0; i < a.size(); ++i) out[i] = {a[i], b[i]};
+  return out;
+}
 
 // True or False (Python or NumPy bools; numbers are refused, so that 0.5 is not read as True).
 bool bool_argument(py::handle value, const std::string& name);
@@ -68,44 +89,48 @@ PinholeCamera camera_argument(py::handle value, const std::string& name,
 // The inverse for results: {"fx", "fy", "cx", "cy", "width", "height"}.
 py::dict camera_to_dict(const PinholeCamera& camera);
 
+// f() with the GIL released, for the core's work (which touches no Python object).
+template <typename F>
+auto without_gil(F f) {
+  py::gil_scoped_release release;
+  return f();
+}
+
 // Results: copies into new NumPy arrays.
 // A fixed-size column vector becomes a 1-D array, anything else a C-contiguous 2-D array.
 template <typename Derived>
 py::array_t<double> to_array(const Eigen::MatrixBase<Derived>& m) {
-  if constexpr (Derived::ColsAtCompileTime == 1) {
-    py::array_t<double> a(static_cast<py::ssize_t>(m.rows()));
-    for (Eigen::Index i = 0; i < m.rows(); ++i) a.mutable_data()[i] = m(i);
-    return a;
-  } else {
-    py::array_t<double> a({static_cast<py::ssize_t>(m.rows()), static_cast<py::ssize_t>(m.cols())});
-    auto out = a.template mutable_unchecked<2>();
-    for (Eigen::Index i = 0; i < m.rows(); ++i)
-      for (Eigen::Index j = 0; j < m.cols(); ++j) out(i, j) = m(i, j);
-    return a;
-  }
-}
-// A mask (std::vector<char> or <bool>) as a bool array.
-template <typename Mask>
-py::array_t<bool> to_bool_array(const Mask& mask) {
-  py::array_t<bool> a(static_cast<py::ssize_t>(mask.size()));
-  for (size_t i = 0; i < mask.size(); ++i) a.mutable_data()[i] = mask[i] != 0;
+  std::vector<py::ssize_t> shape = {m.rows()};
+  if (Derived::ColsAtCompileTime != 1) shape.push_back(m.cols());
+  py::array_t<double> a(shape);
+  Eigen::Map<RowMatrix>(a.mutable_data(), m.rows(), m.cols()) = m;
   return a;
 }
-py::array_t<int64_t> to_int_array(const std::vector<int>& values);
-// An N x cols array whose row i is row(items[i]), an Eigen vector of `cols` values.
-template <typename Scalar, int Cols, typename T, typename Row>
-py::array_t<Scalar> rows_to_array(const std::vector<T>& items, Row row) {
-  py::array_t<Scalar> a({static_cast<py::ssize_t>(items.size()), py::ssize_t{Cols}});
+// A 1-D array of `values`: a mask (std::vector<char> or <bool>) as bool, labels as int64.
+template <typename Scalar, typename Values>
+py::array_t<Scalar> array_of(const Values& values) {
+  py::array_t<Scalar> a(static_cast<py::ssize_t>(values.size()));
+  std::copy(values.begin(), values.end(), a.mutable_data());
+  return a;
+}
+// Rows for rows_to_array: an Eigen vector as it is, a segment as (x1, y1, x2, y2).
+inline constexpr auto same_row = [](const auto& v) { return v; };
+inline Eigen::Vector4d segment_row(const LineSegment& s) {
+  return {s.p1.x(), s.p1.y(), s.p2.x(), s.p2.y()};
+}
+// An N x Cols array whose row i is row(items[i]), an Eigen vector of Cols values, for the first
+// `n` items (all by default).
+template <typename Scalar, int Cols, typename Items, typename Row = decltype(same_row)>
+py::array_t<Scalar> rows_to_array(const Items& items, Row row = same_row, size_t n = SIZE_MAX) {
+  n = std::min(n, items.size());
+  py::array_t<Scalar> a({static_cast<py::ssize_t>(n), py::ssize_t{Cols}});
   Scalar* out = a.mutable_data();
-  for (const T& item : items) {
-    const Eigen::Matrix<Scalar, Cols, 1> values = row(item);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Matrix<Scalar, Cols, 1> values = row(items[i]);
     out = std::copy(values.data(), values.data() + Cols, out);
   }
   return a;
 }
-py::array_t<double> points_to_array(const std::vector<Eigen::Vector2d>& points);
-py::array_t<double> segments_to_array(const std::vector<LineSegment>& segments);
-py::array_t<double> directions_to_array(const std::vector<Eigen::Vector3d>& directions);
 // A pose as the tuple (R, t).
 py::tuple pose_to_tuple(const RelativePose& pose);
 // Point and segment matches as estimate_relative_pose takes them: points1, points2 (N x 2),

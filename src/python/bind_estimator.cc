@@ -1,6 +1,5 @@
 // estimate_relative_pose: the hybrid estimator with VP detection in front (estimate_two_view),
 // its options, and its result object.
-#include "bindings.h"
 #include "hybrid_vo/lines/two_view.h"
 #include "options.h"
 
@@ -8,15 +7,6 @@ namespace hybrid_vo::python {
 namespace {
 
 using namespace pybind11::literals;
-
-// Both of a pair of arguments, or neither (None).
-bool both_or_neither(py::handle a, py::handle b, const char* name_a, const char* name_b) {
-  if (a.is_none() != b.is_none())
-    throw_value_error(a.is_none() ? name_a : name_b, std::string("None while ") +
-                                                         (a.is_none() ? name_b : name_a) +
-                                                         " is given (pass both or neither)");
-  return !a.is_none();
-}
 
 // Per VP match whether d2 = +R d1 is known: one bool for all, or one each.
 void read_vp_signs_known(py::handle value, std::vector<VpMatch>* vps) {
@@ -41,35 +31,23 @@ TwoViewMatches read_matches(py::handle points1, py::handle points2, py::handle s
                             py::handle segments2, py::handle vps, py::handle line_vp,
                             py::handle vp_signs_known) {
   TwoViewMatches matches;
-  if (both_or_neither(points1, points2, "points1", "points2")) {
-    const auto p1 = points_argument(points1, "points1"), p2 = points_argument(points2, "points2");
-    check_same_rows(p1.size(), "points1", p2.size(), "points2");
-    matches.points.resize(p1.size());
-    for (size_t i = 0; i < p1.size(); ++i) matches.points[i] = {p1[i], p2[i]};
-  }
-  const bool segments = both_or_neither(segments1, segments2, "segments1", "segments2");
-  if (segments) {
-    const auto s1 = segments_argument(segments1, "segments1");
-    const auto s2 = segments_argument(segments2, "segments2");
-    check_same_rows(s1.size(), "segments1", s2.size(), "segments2");
-    matches.lines.resize(s1.size());
-    for (size_t i = 0; i < s1.size(); ++i) matches.lines[i] = {s1[i], s2[i]};
-  }
+  matches.points =
+      matches_argument<PointMatch>(points1, points2, "points1", "points2", points_argument, true);
+  matches.lines = matches_argument<LineMatch>(segments1, segments2, "segments1", "segments2",
+                                              segments_argument, true);
   if (!vps.is_none()) {
     if (!(py::isinstance<py::tuple>(vps) || py::isinstance<py::list>(vps)) || py::len(vps) != 2)
       throw_value_error("vps", "expected a pair (directions1, directions2) of K x 3 arrays");
     const py::sequence pair = py::reinterpret_borrow<py::sequence>(vps);
-    const auto d1 = directions_argument(pair[0], "vps[0]");
-    const auto d2 = directions_argument(pair[1], "vps[1]");
-    check_same_rows(d1.size(), "vps[0]", d2.size(), "vps[1]");
-    for (size_t k = 0; k < d1.size(); ++k) matches.vps.push_back({d1[k], d2[k], false});
+    matches.vps =
+        matches_argument<VpMatch>(pair[0], pair[1], "vps[0]", "vps[1]", directions_argument);
   }
   if (!vp_signs_known.is_none()) {
     if (vps.is_none()) throw_value_error("vp_signs_known", "given without vps");
     read_vp_signs_known(vp_signs_known, &matches.vps);
   }
   if (!line_vp.is_none()) {
-    if (vps.is_none() || !segments)
+    if (vps.is_none() || segments1.is_none())
       throw_value_error("line_vp", "labels segments with VPs: needs segments1/2 and vps");
     matches.line_vp = labels_argument(line_vp, "line_vp");
     if (matches.line_vp.size() != matches.lines.size())
@@ -86,19 +64,6 @@ TwoViewMatches read_matches(py::handle points1, py::handle points2, py::handle s
   return matches;
 }
 
-// Derived point matches as rows (x1, y1, x2, y2), and their sources as rows (first, second).
-py::array_t<double> derived_points(const std::vector<DerivedPoint>& derived) {
-  return rows_to_array<double, 4>(derived, [](const DerivedPoint& d) {
-    return Eigen::Vector4d(d.match.x1.x(), d.match.x1.y(), d.match.x2.x(), d.match.x2.y());
-  });
-}
-
-py::array_t<int64_t> derived_sources(const std::vector<DerivedPoint>& derived) {
-  return rows_to_array<int64_t, 2>(derived, [](const DerivedPoint& d) {
-    return Eigen::Matrix<int64_t, 2, 1>(d.first, d.second);
-  });
-}
-
 // The estimate as the fields of hybrid_vo.RelativePoseEstimate (python/hybrid_vo/__init__.py).
 py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py::handle points2,
                   py::handle segments1, py::handle segments2, py::handle vps, py::handle preset,
@@ -109,11 +74,8 @@ py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py
   apply_options(options, &two_view_options, "estimate_relative_pose");
   TwoViewMatches matches =
       read_matches(points1, points2, segments1, segments2, vps, line_vp, vp_signs_known);
-  TwoViewEstimate two_view;
-  {
-    py::gil_scoped_release release;
-    two_view = estimate_two_view(c1, c2, matches, two_view_options);
-  }
+  const TwoViewEstimate two_view =
+      without_gil([&] { return estimate_two_view(c1, c2, matches, two_view_options); });
   const RelativePoseEstimate& e = two_view.estimate;
   const bool ok = e.status == EstimationStatus::kOk;
   py::dict solvers;
@@ -128,19 +90,16 @@ py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py
       "R"_a = ok ? py::object(to_array(e.pose.R)) : none,
       "t"_a = ok ? py::object(to_array(e.pose.t)) : none,
       "covariance"_a = ok && e.covariance_valid ? py::object(to_array(e.covariance)) : none,
-      "point_inliers"_a = to_bool_array(e.point_inliers),
-      "line_inliers"_a = to_bool_array(e.line_inliers),
-      "vp_inliers"_a = to_bool_array(e.vp_inliers),
-      "junction_inliers"_a = to_bool_array(e.junction_inliers),
-      "endpoint_inliers"_a = to_bool_array(e.endpoint_inliers),
+      "point_inliers"_a = array_of<bool>(e.point_inliers),
+      "line_inliers"_a = array_of<bool>(e.line_inliers),
+      "vp_inliers"_a = array_of<bool>(e.vp_inliers),
+      "junction_inliers"_a = array_of<bool>(e.junction_inliers),
+      "endpoint_inliers"_a = array_of<bool>(e.endpoint_inliers),
       "num_point_inliers"_a = e.num_point_inliers, "num_line_inliers"_a = e.num_line_inliers,
       "num_vp_inliers"_a = e.num_vp_inliers, "num_junction_inliers"_a = e.num_junction_inliers,
       "num_endpoint_inliers"_a = e.num_endpoint_inliers,
-      "junctions"_a = derived_points(e.junctions),
-      "junction_segments"_a = derived_sources(e.junctions),
-      "endpoints"_a = derived_points(e.endpoints),
-      "endpoint_segments"_a = derived_sources(e.endpoints),
-      "line_vp"_a = to_int_array(two_view.vps_detected ? two_view.vps.labels : matches.line_vp),
+      "line_vp"_a =
+          array_of<int64_t>(two_view.vps_detected ? two_view.vps.labels : matches.line_vp),
       "vps_detected"_a = two_view.vps_detected, "solver_statistics"_a = solvers,
       "best_solver"_a = ok ? py::object(py::str(solver_info(e.best_solver).function)) : none,
       "iterations"_a = e.iterations, "local_optimizations"_a = e.local_optimizations,
@@ -151,6 +110,17 @@ py::dict estimate(py::handle camera1, py::handle camera2, py::handle points1, py
           py::dict("vp_detection_ms"_a = two_view.vp_ms, "derive_ms"_a = e.derive_ms,
                    "ransac_ms"_a = e.ransac_ms, "refine_ms"_a = e.refine_ms,
                    "estimator_ms"_a = e.total_ms, "total_ms"_a = two_view.vp_ms + e.total_ms));
+  // Derived point matches as rows (x1, y1, x2, y2), and their sources as rows (first, second).
+  for (const auto& [kind, derived] :
+       {std::pair{"junction", &e.junctions}, std::pair{"endpoint", &e.endpoints}}) {
+    fields[py::str(kind + std::string("s"))] =
+        rows_to_array<double, 4>(*derived, [](const DerivedPoint& d) {
+          return (Eigen::Vector4d() << d.match.x1, d.match.x2).finished();
+        });
+    fields[py::str(kind + std::string("_segments"))] = rows_to_array<int64_t, 2>(
+        *derived,
+        [](const DerivedPoint& d) { return Eigen::Matrix<int64_t, 2, 1>(d.first, d.second); });
+  }
   // The VP matches used: detected, or the given ones.
   fields.attr("update")(vps_to_dict(two_view.vps_detected ? two_view.vps.matches : matches.vps));
   return fields;
@@ -167,12 +137,9 @@ void bind_estimator(py::module_& m) {
       [](py::handle preset) { return options_dict(preset_two_view_options(preset)); },
       "preset"_a = "hybrid+junc",
       "estimator_options(preset='hybrid+junc')\n--\n\n"
-      "Every keyword option of estimate_relative_pose with its value under `preset`, as a dict. "
-      "Names\nare the C++ structs' own (visit_fields): HybridRansacOptions and "
-      "RelativePoseEstimatorOptions\nfields as they are, its components as junctions_*, "
-      "refinement_*, scales_*, and the VP detection\nin front (TwoViewOptions) as detect_vps, "
-      "joint_vp_detection and vp_detection_*. 'enabled' and\n'prior' are per solver: pass a "
-      "dict {solver: value} or a list in the paper's order.");
+      "Every keyword option of estimate_relative_pose with its value under `preset`, as a dict: "
+      "the fields\nof the C++ option structs (doc/python.md, Options). 'enabled' and 'prior' are "
+      "per solver: pass\na dict {solver: value} or a list in the paper's order.");
 
   m.def(
       "presets", [] { return preset_names(); },

@@ -1,11 +1,9 @@
 // The minimal solvers (paper Fig. 2) through the dispatcher the hybrid RANSAC uses (the package
 // makes one function per solver from the table), the solver table, and pose errors.
-#include <map>
-
-#include "bindings.h"
 #include "hybrid_vo/geometry/epipolar_error.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/solvers/minimal_solver.h"
+#include "options.h"
 
 namespace hybrid_vo::python {
 namespace {
@@ -24,18 +22,14 @@ Eigen::Vector3d translation_argument(py::handle value, const char* name) {
 // dispatcher takes it: exactly the arrays the solver takes, each with the rows it uses.
 MinimalSample read_sample(const SolverInfo& info, const py::kwargs& arrays) {
   MinimalSample sample;
-  std::map<std::string, py::handle> given;
-  for (const auto& [name, value] : arrays) given[py::str(name)] = value;
   auto read = [&](const char* name, int count, const char* what, auto* out, auto convert) {
-    const auto it = given.find(name);
-    if (count == 0 && it != given.end())
+    if (count == 0 && arrays.contains(name))
       throw_value_error(name, std::string(info.function) + " takes no " + what);
-    if (count > 0 && it == given.end())
+    if (count > 0 && !arrays.contains(name))
       throw_value_error(name, "required by " + std::string(info.function));
-    if (count > 0) {
-      const auto rows = convert(it->second, name, count);
-      std::copy(rows.begin(), rows.end(), out->begin());
-    }
+    if (count == 0) return;
+    const auto rows = convert(arrays[name], name, count);
+    std::copy(rows.begin(), rows.end(), out->begin());
   };
   read("x1", info.num_points, "points", &sample.x1, points_argument);
   read("x2", info.num_points, "points", &sample.x2, points_argument);
@@ -110,22 +104,19 @@ void bind_solvers(py::module_& m) {
         const PinholeCamera c1 = camera_argument(camera1, "camera1");
         const PinholeCamera c2 = camera_argument(camera2, "camera2");
         const RelativePose pose(rotation_argument(R, "R"), translation_argument(t, "t"));
-        const auto p1 = points_argument(points1, "points1"),
-                   p2 = points_argument(points2, "points2");
-        check_same_rows(p1.size(), "points1", p2.size(), "points2");
         std::vector<double> errors;
-        for (size_t i = 0; i < p1.size(); ++i)
-          errors.push_back(sampson_error_px(c1, c2, pose, p1[i], p2[i]));
-        return py::array_t<double>(errors.size(), errors.data());
+        for (const PointMatch& m :
+             matches_argument<PointMatch>(points1, points2, "points1", "points2", points_argument))
+          errors.push_back(sampson_error_px(c1, c2, pose, m.x1, m.x2));
+        return array_of<double>(errors);
       },
       "camera1"_a, "camera2"_a, "R"_a, "t"_a, "points1"_a, "points2"_a,
       "sampson_errors_px(camera1, camera2, R, t, points1, points2)\n--\n\n"
       "Sampson error in pixels of every point match (row i of points1 with row i of points2, "
       "N x 2\nundistorted pixels) under the pose X2 = R X1 + t: the point residual that the "
       "estimator scores\nagainst its 1 px threshold. An (N,) array; all NaN when t is zero. "
-      "With the true pose it\nmeasures the ground truth (how far a data set's truth can rank "
-      "estimators); on matches an\nestimate did not see it scores the estimate without ground "
-      "truth (hybrid_vo_eval_pairs\n--held-out).");
+      "With the true pose it\nmeasures the ground truth; on held-out matches it scores an estimate "
+      "(hybrid_vo_eval_pairs\n--held-out).");
 }
 
 }  // namespace hybrid_vo::python

@@ -2,7 +2,6 @@
 // scenes, so that Python tests and benchmarks run on exactly the data the C++ ones use.
 #include <random>
 
-#include "bindings.h"
 #include "hybrid_vo/synthetic/manhattan_scene.h"
 #include "hybrid_vo/synthetic/minimal_instances.h"
 #include "options.h"
@@ -12,24 +11,16 @@ namespace {
 
 using namespace pybind11::literals;
 
-uint64_t seed_argument(py::handle value) {
-  uint64_t seed = 0;
-  read_option(value, "seed", Bounds(), &seed);
-  return seed;
-}
-
 // The inputs of the solver's own function, by its parameter names.
 py::dict solver_inputs(const SolverInfo& info, const MinimalSample& s) {
   py::dict inputs;
   const int np = info.num_points, nl = info.num_lines, nv = info.num_vps;
   for (const auto& [name, points] : {std::pair{"x1", &s.x1}, std::pair{"x2", &s.x2}})
-    if (np > 0) inputs[name] = points_to_array({points->begin(), points->begin() + np});
+    if (np > 0) inputs[name] = rows_to_array<double, 2>(*points, same_row, np);
   for (const auto& [name, lines] : {std::pair{"s1", &s.s1}, std::pair{"s2", &s.s2}})
-    if (nl > 0) inputs[name] = segments_to_array({lines->begin(), lines->begin() + nl});
-  for (const auto& [name, vps] : {std::pair{"v1", &s.v1}, std::pair{"v2", &s.v2}}) {
-    if (nv == 1) inputs[name] = to_array((*vps)[0]);
-    if (nv == 2) inputs[name] = directions_to_array({(*vps)[0], (*vps)[1]});
-  }
+    if (nl > 0) inputs[name] = rows_to_array<double, 4>(*lines, segment_row, nl);
+  for (const auto& [name, vps] : {std::pair{"v1", &s.v1}, std::pair{"v2", &s.v2}})
+    if (nv > 0) inputs[name] = nv == 1 ? to_array((*vps)[0]) : rows_to_array<double, 3>(*vps);
   if (nv > 0) inputs[nv == 1 ? "vp_sign_known" : "vp_signs_known"] = s.vp_signs_known;
   return inputs;
 }
@@ -41,14 +32,14 @@ py::dict scene_to_dict(const ManhattanScene& scene) {
   inputs.attr("update")(matches_to_dict(m));
   if (!m.vps.empty()) {
     inputs.attr("update")(vps_to_dict(m.vps));
-    if (!m.line_vp.empty()) inputs["line_vp"] = to_int_array(m.line_vp);
+    if (!m.line_vp.empty()) inputs["line_vp"] = array_of<int64_t>(m.line_vp);
   }
   return py::dict("inputs"_a = inputs, "R"_a = to_array(scene.truth.R),
                   "t"_a = to_array(scene.truth.t), "baseline_m"_a = scene.baseline_m,
                   "directions"_a = to_array(scene.directions),
-                  "point_inlier"_a = to_bool_array(scene.point_inlier),
-                  "line_inlier"_a = to_bool_array(scene.line_inlier),
-                  "line_direction"_a = to_int_array(scene.line_direction));
+                  "point_inlier"_a = array_of<bool>(scene.point_inlier),
+                  "line_inlier"_a = array_of<bool>(scene.line_inlier),
+                  "line_direction"_a = array_of<int64_t>(scene.line_direction));
 }
 
 }  // namespace
@@ -66,13 +57,13 @@ void bind_synthetic(py::module_& parent) {
         const SolverInfo& info = solver_info(solver_argument(solver, "solver"));
         MinimalInstanceOptions options;
         apply_options(kwargs, &options, "minimal_instance");
-        std::mt19937_64 rng(seed_argument(seed));
+        std::mt19937_64 rng(integer_option(seed, "seed", Bounds(), 0, UINT64_MAX));
         const MinimalInstance instance = generate_minimal_instance(info.id, rng, options);
         return py::dict("solver"_a = info.function,
                         "inputs"_a = solver_inputs(info, instance.sample),
                         "R"_a = to_array(instance.truth.R), "t"_a = to_array(instance.truth.t),
-                        "extra_x1"_a = points_to_array(instance.extra_x1),
-                        "extra_x2"_a = points_to_array(instance.extra_x2));
+                        "extra_x1"_a = rows_to_array<double, 2>(instance.extra_x1),
+                        "extra_x2"_a = rows_to_array<double, 2>(instance.extra_x2));
       },
       "solver"_a, "seed"_a = 0,
       "minimal_instance(solver, seed=0, *, noise=0.0, lines_per_vp=2, orient_vps=False, "
@@ -91,7 +82,7 @@ void bind_synthetic(py::module_& parent) {
         read_option(count, "count", non_negative(), &n);
         ManhattanSceneOptions options;
         apply_options(kwargs, &options, "manhattan_scenes");
-        std::mt19937_64 rng(seed_argument(seed));
+        std::mt19937_64 rng(integer_option(seed, "seed", Bounds(), 0, UINT64_MAX));
         py::list out;
         for (int i = 0; i < n; ++i)
           out.append(scene_to_dict(generate_manhattan_scene(rng, options)));

@@ -22,15 +22,12 @@ cv::Mat image_argument(py::handle value, const std::string& name, py::array* kee
                                 std::string(py::str(py::type::handle_of(value).attr("__name__"))));
   *keep = py::reinterpret_borrow<py::array>(value);
   const py::array& a = *keep;
-  if (!py::isinstance<py::array_t<uint8_t>>(a))
-    throw_value_error(name, "dtype " + std::string(py::str(a.dtype())) + ", expected uint8");
+  check_array(a, name, py::isinstance<py::array_t<uint8_t>>(a), "uint8");
   const bool grey = a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 1);
   const bool colour = a.ndim() == 3 && (a.shape(2) == 3 || a.shape(2) == 4);
   if (!grey && !colour)
     throw_value_error(name, "expected H x W (grey), H x W x 3 (BGR) or H x W x 4 (BGRA)");
   if (a.shape(0) == 0 || a.shape(1) == 0) throw_value_error(name, "empty image");
-  if (!(a.flags() & py::array::c_style))
-    throw_value_error(name, "not C-contiguous; pass np.ascontiguousarray(" + name + ")");
   const int channels = a.ndim() == 3 ? static_cast<int>(a.shape(2)) : 1;
   return cv::Mat(static_cast<int>(a.shape(0)), static_cast<int>(a.shape(1)), CV_8UC(channels),
                  const_cast<void*>(a.data()));
@@ -62,13 +59,10 @@ py::dict match_image_pair(py::handle image1, py::handle image2, py::handle camer
   const long long n = integer_argument(max_features, "max_features");
   if (n <= 0 || n > 1000000) throw_value_error("max_features", "expected 1 .. 1000000");
   options.points.max_features = static_cast<int>(n);
-  TwoViewMatches matches;
-  {
-    py::gil_scoped_release release;
-    const ImageFeatures f1 = extract_features(im1, options);
-    const ImageFeatures f2 = extract_features(im2, options);
-    matches = match_features(f1, f2, c1, c2, options);
-  }
+  const TwoViewMatches matches = without_gil([&] {
+    const ImageFeatures f1 = extract_features(im1, options), f2 = extract_features(im2, options);
+    return match_features(f1, f2, c1, c2, options);
+  });
   py::dict out("camera1"_a = camera_to_dict(c1.pinhole), "camera2"_a = camera_to_dict(c2.pinhole));
   out.attr("update")(matches_to_dict(matches));
   return out;

@@ -1,6 +1,13 @@
 // hybrid_vo._core: the core library (solvers, estimator, VP detection, synthetic data) for
-// Python. python/hybrid_vo/__init__.py re-exports it as the package hybrid_vo.
-#include "bindings.h"
+// Python, one file a part. python/hybrid_vo/__init__.py re-exports it as the package hybrid_vo.
+#include <pybind11/pybind11.h>
+
+namespace hybrid_vo::python {
+void bind_solvers(pybind11::module_& m);
+void bind_estimator(pybind11::module_& m);
+void bind_vanishing_points(pybind11::module_& m);
+void bind_synthetic(pybind11::module_& m);
+}  // namespace hybrid_vo::python
 
 PYBIND11_MODULE(_core, m) {
   namespace python = hybrid_vo::python;

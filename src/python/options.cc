@@ -57,19 +57,14 @@ std::string current_option_name(const std::string& name, const std::string& func
 void throw_unknown_options(const std::vector<std::string>& unknown,
                            const std::vector<std::string>& known, const std::string& function) {
   const py::object close = py::module_::import("difflib").attr("get_close_matches");
-  std::string message = function + ": unknown option" + (unknown.size() > 1 ? "s " : " ");
-  std::vector<std::string> hints;
+  std::string message = function + ": unknown option" + (unknown.size() > 1 ? "s " : " "), hints;
   for (size_t i = 0; i < unknown.size(); ++i) {
     message += (i ? ", '" : "'") + unknown[i] + "'";
     for (const auto& match : close(unknown[i], py::cast(known), 1))
-      hints.push_back("'" + std::string(py::str(match)) + "' for '" + unknown[i] + "'");
+      hints += (hints.empty() ? " (did you mean '" : ", '") + std::string(py::str(match)) +
+               "' for '" + unknown[i] + "'";
   }
-  if (!hints.empty()) {
-    message += " (did you mean ";
-    for (size_t i = 0; i < hints.size(); ++i) message += (i ? ", " : "") + hints[i];
-    message += "?)";
-  }
-  throw py::value_error(message);
+  throw py::value_error(message + hints + (hints.empty() ? "" : "?)"));
 }
 
 TwoViewOptions preset_two_view_options(py::handle preset) {

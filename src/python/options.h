@@ -73,21 +73,14 @@ std::string current_option_name(const std::string& name, const std::string& func
                                         const std::vector<std::string>& known,
                                         const std::string& function);
 
-template <typename Options>
-std::vector<std::string> option_names() {
-  std::vector<std::string> names;
-  Options options;
-  visit_fields(options,
-               [&](const std::string& name, auto&, const Bounds& = {}) { names.push_back(name); });
-  return names;
-}
-
 // Sets every option of `values` (keyword -> value) and validates the result; ValueError naming
 // the option for an unknown name, a value of the wrong type or one out of bounds.
 template <typename Options>
 void apply_options(const py::dict& values, Options* options, const std::string& function) {
   if (values.empty()) return;  // the defaults and the presets are valid
-  const std::vector<std::string> known = option_names<Options>();
+  std::vector<std::string> known;
+  visit_fields(*options,
+               [&](const std::string& name, auto&, const Bounds& = {}) { known.push_back(name); });
   std::map<std::string, std::pair<std::string, py::handle>> given;  // name -> (keyword, value)
   std::vector<std::string> unknown;
   for (const auto& [key, value] : values) {
