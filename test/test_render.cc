@@ -26,6 +26,7 @@ using namespace hybrid_vo;
 using namespace hybrid_vo::render;
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::infinity();
@@ -61,6 +62,24 @@ float bilinear(const cv::Mat& image, double x, double y) {
   cv::getRectSubPix(image, cv::Size(1, 1),
                     cv::Point2f(static_cast<float>(x), static_cast<float>(y)), patch, CV_32F);
   return patch.at<float>(0, 0);
+}
+
+// How far cornerSubPix, started 1.4 px off, ends from landmark lm's projection p, with a
+// (2 half_window + 1)^2 window; NaN unless lm is visible (nothing in front, and its own quad all
+// around it) and faces the camera obliquely enough that its corner is not a sliver.
+double painted_corner_error(const Scene& scene, const RenderedView& view, const CameraPose& pose,
+                            const Landmark& lm, const Eigen::Vector2d& p, int half_window) {
+  const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+  for (int dy = -5; dy <= 5; ++dy)
+    for (int dx = -5; dx <= 5; ++dx)
+      if (view.quad_id.at<int>(y + dy, x + dx) != lm.quad) return kNaN;
+  const Quad& q = scene.quads[lm.quad];
+  if (q.normal.dot((pose.centre - lm.position).normalized()) < 0.5) return kNaN;
+  std::vector<cv::Point2f> corner = {
+      cv::Point2f(static_cast<float>(p.x() + 1.2), static_cast<float>(p.y() - 0.8))};
+  cv::cornerSubPix(view.image, corner, cv::Size(half_window, half_window), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-3));
+  return std::hypot(corner[0].x - p.x(), corner[0].y - p.y());
 }
 
 // The three Manhattan VPs (world axes) in homogeneous pixels.
@@ -214,22 +233,8 @@ TEST_F(RenderTest, PaintedCornersProjectWhereExpected) {
       Eigen::Vector2d p;
       double z = 0.0;
       if (!project(cam, pose, lm.position, 12.0, &p, &z) || z > 5.0) continue;
-      const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
-      // Visible: nothing in front, and the surface around it is its own quad.
-      bool visible = true;
-      for (int dy = -5; dy <= 5; ++dy)
-        for (int dx = -5; dx <= 5; ++dx)
-          visible = visible && view.quad_id.at<int>(y + dy, x + dx) == lm.quad;
-      if (!visible) continue;
-      // Facing the camera obliquely enough that the corner is not a sliver.
-      const Quad& q = seq().scene.quads[lm.quad];
-      const Eigen::Vector3d to_camera = (pose.centre - lm.position).normalized();
-      if (q.normal.dot(to_camera) < 0.5) continue;
-      std::vector<cv::Point2f> corner = {
-          cv::Point2f(static_cast<float>(p.x() + 1.2), static_cast<float>(p.y() - 0.8))};
-      cv::cornerSubPix(view.image, corner, cv::Size(3, 3), cv::Size(-1, -1),
-                       cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-3));
-      errors.push_back(std::hypot(corner[0].x - p.x(), corner[0].y - p.y()));
+      const double error = painted_corner_error(seq().scene, view, pose, lm, p, 3);
+      if (std::isfinite(error)) errors.push_back(error);
     }
   }
   ASSERT_GE(errors.size(), 40u);
@@ -910,20 +915,10 @@ TEST_F(FisheyeRenderTest, PaintedCornersProjectThroughTheLens) {
       if (!lens.project(X, &p) || X.norm() > 5.0 || p.x() < 12 || p.y() < 12 ||
           p.x() > lens.pinhole.width - 13 || p.y() > lens.pinhole.height - 13)
         continue;
-      const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
-      bool visible = true;
-      for (int dy = -5; dy <= 5; ++dy)
-        for (int dx = -5; dx <= 5; ++dx)
-          visible = visible && view.quad_id.at<int>(y + dy, x + dx) == lm.quad;
-      const Quad& q = seq().scene.quads[lm.quad];
-      if (!visible || q.normal.dot((pose.centre - lm.position).normalized()) < 0.5) continue;
       // A 5 x 5 window, not the pinhole test's 7 x 7: the fisheye's pixels are about twice as
       // wide, so the painted corners come twice as close to one another.
-      std::vector<cv::Point2f> corner = {
-          cv::Point2f(static_cast<float>(p.x() + 1.2), static_cast<float>(p.y() - 0.8))};
-      cv::cornerSubPix(view.image, corner, cv::Size(2, 2), cv::Size(-1, -1),
-                       cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 40, 1e-3));
-            errors.push_back(std::hypot(corner[0].x - p.x(), corner[0].y - p.y()));
+      const double error = painted_corner_error(seq().scene, view, pose, lm, p, 2);
+      if (std::isfinite(error)) errors.push_back(error);
     }
   }
   ASSERT_GE(errors.size(), 30u);

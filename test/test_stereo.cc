@@ -21,6 +21,7 @@
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/rotation.h"
 #include "hybrid_vo/render/sequence.h"
+#include "image_test_utils.h"
 
 namespace {
 using namespace hybrid_vo;
@@ -284,11 +285,7 @@ TEST(StereoPoints, RenderedPairHasUnbiasedDisparities) {
 // Issue 32: the searches split over threads (backwards, and on a worker thread beside this one)
 // give the points of one thread, with and without predicted disparities.
 TEST(StereoPoints, SplitSearchesGiveTheSamePoints) {
-  cv::Mat noise(300, 500, CV_8U);
-  cv::randu(noise, 0, 255);
-  cv::Mat left;
-  cv::GaussianBlur(noise, left, cv::Size(0, 0), 2.0);
-  cv::normalize(left, left, 0, 255, cv::NORM_MINMAX);
+  const cv::Mat left = hybrid_vo::testing::blurred_noise(300, 500, 2.0);
   // The right image: the left one sheared, disparity 8 px at the top to 20 px at the bottom.
   cv::Mat right;
   cv::Mat map_x(left.size(), CV_32F), map_y(left.size(), CV_32F);

@@ -26,6 +26,7 @@
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/render/renderer.h"
 #include "hybrid_vo/render/sequence.h"
+#include "image_test_utils.h"
 
 namespace {
 
@@ -301,11 +302,7 @@ TEST_F(VideoFrontEnd, StereoScalePointsDoNotLagOnApproachingSurfaces) {
 // the gap's motion (two steps), without them one step, and the one-level search from there
 // misses. Textured noise, shifted by whole pixels, so that the truth is exact.
 TEST(KltTracker, StampsCarryThePredictionOverADroppedFrame) {
-  cv::Mat noise(700, 1000, CV_8U);
-  cv::randu(noise, 0, 255);
-  cv::Mat texture;
-  cv::GaussianBlur(noise, texture, cv::Size(0, 0), 2.5);
-  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+  const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1000, 2.5);
   const int step_px = 14;  // image motion per frame
   auto frame = [&](int k) { return texture(cv::Rect(200 - k * step_px, 100, 640, 480)).clone(); };
   // Frames 0, 1, 2 at 10 Hz, then frame 4 (frame 3 lost).
@@ -345,11 +342,7 @@ bool same_tracker(const KltTracker& a, const KltTracker& b) {
 // on a worker thread beside this one) give the tracks of the sequential tracker, also when
 // max_features leaves less room than the empty cells want.
 TEST(KltTracker, SplitSearchesAndCellsGiveTheSameTracks) {
-  cv::Mat noise(700, 1000, CV_8U);
-  cv::randu(noise, 0, 255);
-  cv::Mat texture;
-  cv::GaussianBlur(noise, texture, cv::Size(0, 0), 2.5);
-  cv::normalize(texture, texture, 0, 255, cv::NORM_MINMAX);
+  const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1000, 2.5);
   // Zooming in about a point left of centre: the flow differs across the image and features
   // leave it on the left, so tracks are lost and cells refilled unevenly.
   auto frame = [&](int k) {

@@ -68,12 +68,11 @@ Eigen::Matrix3d observation_covariance(const VpObservation& o, const Eigen::Matr
 // Greedy one-to-one association by smallest angle within `gate` (radians): for the handful of
 // VPs per frame this matches the optimal assignment whenever the VPs are further apart than
 // twice the gate, which a VP detector guarantees. `usable[j]` marks the candidate targets.
-// Returns per observation its target index or -1; `angles` gets the matched angles.
+// Returns per observation its target index or -1.
 std::vector<int> associate(const std::vector<Eigen::Vector3d>& observations,
                            const std::vector<char>& valid_observation,
                            const std::vector<Eigen::Vector3d>& targets,
-                           const std::vector<char>& usable, double gate,
-                           std::vector<double>* angles) {
+                           const std::vector<char>& usable, double gate) {
   std::vector<std::tuple<double, int, int>> pairs;  // angle, observation, target
   for (size_t i = 0; i < observations.size(); ++i) {
     if (!valid_observation[i]) continue;
@@ -86,12 +85,10 @@ std::vector<int> associate(const std::vector<Eigen::Vector3d>& observations,
   std::sort(pairs.begin(), pairs.end());
   std::vector<int> target_of(observations.size(), -1);
   std::vector<char> taken(targets.size(), 0);
-  angles->assign(observations.size(), 0.0);
   for (const auto& [a, i, j] : pairs) {
     if (target_of[i] >= 0 || taken[j]) continue;
     target_of[i] = j;
     taken[j] = 1;
-    (*angles)[i] = a;
   }
   return target_of;
 }
@@ -121,6 +118,19 @@ bool fuse(VpTrack* track, const Eigen::Vector3d& z, const Eigen::Matrix3d& C) {
 }
 
 }  // namespace
+
+std::vector<int> VpTracker::associate_with_tracks(const std::vector<Eigen::Vector3d>& directions,
+                                                  const std::vector<char>& valid,
+                                                  bool confident_only) const {
+  std::vector<Eigen::Vector3d> track_directions;
+  std::vector<char> usable;
+  for (const VpTrack& track : tracks_) {
+    track_directions.push_back(track.direction);
+    usable.push_back(!confident_only || track.confident);
+  }
+  const double gate = std::max(options_.association_angle_deg, 0.0) * kDeg;
+  return associate(directions, valid, track_directions, usable, gate);
+}
 
 double VpTrack::sigma_deg() const {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(0.5 *
@@ -165,13 +175,7 @@ std::vector<VpAssociation> VpTracker::update(const Eigen::Matrix3d& R_world_from
     track.covariance += q * tangent_projector(track.direction);
   }
 
-  std::vector<Eigen::Vector3d> track_directions;
-  for (const VpTrack& track : tracks_) track_directions.push_back(track.direction);
-  const double gate = std::max(options_.association_angle_deg, 0.0) * kDeg;
-  std::vector<double> angles;
-  const std::vector<char> usable(tracks_.size(), 1);
-  const std::vector<int> track_of =
-      associate(world, valid, track_directions, usable, gate, &angles);
+  const std::vector<int> track_of = associate_with_tracks(world, valid, false);
 
   std::vector<char> fused(tracks_.size(), 0), gated(tracks_.size(), 0);
   for (size_t i = 0; i < n; ++i) {
@@ -210,6 +214,7 @@ std::vector<VpAssociation> VpTracker::update(const Eigen::Matrix3d& R_world_from
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(),
                    [&](int a, int b) { return covariance[a].trace() < covariance[b].trace(); });
+  const double gate = std::max(options_.association_angle_deg, 0.0) * kDeg;
   for (const int i : order) {
     if (!valid[i] || track_of[i] >= 0) continue;
     bool duplicate = false;
@@ -261,16 +266,7 @@ AnchoredOrientation VpTracker::anchor(const Eigen::Matrix3d& R_world_from_camera
         observation_covariance(observations[i], R_world_from_camera, world[i], options_);
     valid[i] = all_finite(world_covariance[i]);
   }
-  std::vector<Eigen::Vector3d> track_directions;
-  std::vector<char> confident;
-  for (const VpTrack& track : tracks_) {
-    track_directions.push_back(track.direction);
-    confident.push_back(track.confident);
-  }
-  const double gate = std::max(options_.association_angle_deg, 0.0) * kDeg;
-  std::vector<double> angles;
-  const std::vector<int> track_of =
-      associate(world, valid, track_directions, confident, gate, &angles);
+  const std::vector<int> track_of = associate_with_tracks(world, valid, true);
   std::vector<int> order;
   for (size_t i = 0; i < n; ++i)
     if (track_of[i] >= 0) order.push_back(static_cast<int>(i));
@@ -330,16 +326,7 @@ std::vector<VpPrior> VpTracker::priors(const Eigen::Matrix3d& R_world_from_camer
     world[i] = (R_world_from_camera1 * d1[i]).normalized();
     valid[i] = 1;
   }
-  std::vector<Eigen::Vector3d> track_directions;
-  std::vector<char> confident;
-  for (const VpTrack& track : tracks_) {
-    track_directions.push_back(track.direction);
-    confident.push_back(track.confident);
-  }
-  const double gate = std::max(options_.association_angle_deg, 0.0) * kDeg;
-  std::vector<double> angles;
-  const std::vector<int> track_of = associate(world, valid, track_directions, confident, gate,
-                                              &angles);
+  const std::vector<int> track_of = associate_with_tracks(world, valid, true);
   const double q = std::pow(std::max(options_.process_noise_deg, 0.0) * kDeg, 2);
   for (size_t i = 0; i < n; ++i) {
     if (track_of[i] < 0) continue;

@@ -16,10 +16,6 @@ namespace {
 
 constexpr int kBands = 16;  // horizontal bands rendered in parallel, as the pinhole view's
 
-// Sample (i, j) of a grid with ss samples per pixel looks through image point
-// ((i + 0.5) / ss - 0.5, (j + 0.5) / ss - 0.5), as in the pinhole view.
-double sample_coord(int i, int ss) { return (i + 0.5) / ss - 0.5; }
-
 // The unit ray of every sample in the camera frame (NaN where the lens has none).
 struct SampleRays {
   int ss = 1, width = 0, height = 0;
@@ -54,15 +50,6 @@ SampleRays sample_rays(const CameraModel& camera, int ss) {
   });
   return rays;
 }
-
-// Per-quad constants of the ray-plane test (as the pinhole view's) and its sample bounding box.
-struct QuadRaster {
-  int index = 0;
-  int a = 0, iu = 0, iv = 0;
-  double plane = 0.0;
-  double lo_u = 0.0, hi_u = 0.0, lo_v = 0.0, hi_v = 0.0;
-  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // inclusive, in samples
-};
 
 // Whether the ray from origin along direction meets the quad (either side).
 bool meets(const Quad& q, const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
@@ -112,18 +99,7 @@ std::vector<QuadRaster> setup_quads(const Scene& scene, const CameraModel& camer
   for (size_t i = 0; i < scene.quads.size(); ++i) {
     const Quad& q = scene.quads[i];
     QuadRaster r;
-    r.index = static_cast<int>(i);
-    r.a = q.normal_axis();
-    r.plane = q.origin[r.a];
-    // One-sided: the camera must be on the side the normal points to.
-    if (q.normal[r.a] * (pose.centre[r.a] - r.plane) <= 1e-9) continue;
-    q.u_axis.cwiseAbs().maxCoeff(&r.iu);
-    q.v_axis.cwiseAbs().maxCoeff(&r.iv);
-    const Eigen::Vector3d far = q.point(q.size_u, q.size_v);
-    r.lo_u = std::min(q.origin[r.iu], far[r.iu]);
-    r.hi_u = std::max(q.origin[r.iu], far[r.iu]);
-    r.lo_v = std::min(q.origin[r.iv], far[r.iv]);
-    r.hi_v = std::max(q.origin[r.iv], far[r.iv]);
+    if (!quad_plane(scene, static_cast<int>(i), pose.centre, &r)) continue;
     // Samples to test: the whole image when the quad holds the backward axis (its outline then
     // surrounds the rest of the image) or its outline passes near it, else the outline's box
     // with a margin of 3 pixels for the curve between the outline's points.

@@ -19,25 +19,11 @@ namespace {
 
 constexpr int kBands = 16;  // horizontal bands rendered in parallel; each pixel by one band
 
-// Per-quad constants of the ray-plane test: the plane world[a] = plane, and the quad's extent
-// along the two other world axes iu, iv.
-struct QuadRaster {
-  int index = 0;
-  int a = 0, iu = 0, iv = 0;
-  double plane = 0.0;
-  double lo_u = 0.0, hi_u = 0.0, lo_v = 0.0, hi_v = 0.0;
-  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // sample bounding box, inclusive
-};
-
 struct SampleGrid {
   int ss = 1, width = 0, height = 0;  // samples
   std::vector<float> depth;
   std::vector<int> id;
 };
-
-// Sample (i, j) of a grid with ss samples per pixel looks through image point
-// ((i + 0.5) / ss - 0.5, (j + 0.5) / ss - 0.5).
-double sample_coord(int i, int ss) { return (i + 0.5) / ss - 0.5; }
 
 std::vector<QuadRaster> setup_quads(const Scene& scene, const PinholeCamera& cam,
                                     const CameraPose& pose, int ss, double near, int width,
@@ -47,22 +33,12 @@ std::vector<QuadRaster> setup_quads(const Scene& scene, const PinholeCamera& cam
   for (size_t i = 0; i < scene.quads.size(); ++i) {
     const Quad& q = scene.quads[i];
     QuadRaster r;
-    r.index = static_cast<int>(i);
-    r.a = q.normal_axis();
-    r.plane = q.origin[r.a];
-    // One-sided: the camera must be on the side the normal points to.
-    if (q.normal[r.a] * (pose.centre[r.a] - r.plane) <= 1e-9) continue;
-    q.u_axis.cwiseAbs().maxCoeff(&r.iu);
-    q.v_axis.cwiseAbs().maxCoeff(&r.iv);
-    const Eigen::Vector3d far = q.point(q.size_u, q.size_v);
-    r.lo_u = std::min(q.origin[r.iu], far[r.iu]);
-    r.hi_u = std::max(q.origin[r.iu], far[r.iu]);
-    r.lo_v = std::min(q.origin[r.iv], far[r.iv]);
-    r.hi_v = std::max(q.origin[r.iv], far[r.iv]);
+    if (!quad_plane(scene, static_cast<int>(i), pose.centre, &r)) continue;
     // Clip the quad to z >= near in the camera and bound its projection.
-    std::array<Eigen::Vector3d, 4> corners = {
-        Rt * (q.origin - pose.centre), Rt * (q.point(q.size_u, 0) - pose.centre),
-        Rt * (far - pose.centre), Rt * (q.point(0, q.size_v) - pose.centre)};
+    std::array<Eigen::Vector3d, 4> corners = {Rt * (q.origin - pose.centre),
+                                              Rt * (q.point(q.size_u, 0) - pose.centre),
+                                              Rt * (q.point(q.size_u, q.size_v) - pose.centre),
+                                              Rt * (q.point(0, q.size_v) - pose.centre)};
     std::vector<Eigen::Vector3d> clipped;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d& p = corners[k];

@@ -104,5 +104,21 @@ cv::Mat finish(cv::Mat radiance, const RenderOptions& o) {
   return image;
 }
 
+bool quad_plane(const Scene& scene, int index, const Eigen::Vector3d& centre, QuadRaster* r) {
+  const Quad& q = scene.quads[index];
+  r->index = index;
+  r->a = q.normal_axis();
+  r->plane = q.origin[r->a];
+  if (q.normal[r->a] * (centre[r->a] - r->plane) <= 1e-9) return false;
+  q.u_axis.cwiseAbs().maxCoeff(&r->iu);
+  q.v_axis.cwiseAbs().maxCoeff(&r->iv);
+  const Eigen::Vector3d far = q.point(q.size_u, q.size_v);
+  r->lo_u = std::min(q.origin[r->iu], far[r->iu]);
+  r->hi_u = std::max(q.origin[r->iu], far[r->iu]);
+  r->lo_v = std::min(q.origin[r->iv], far[r->iv]);
+  r->hi_v = std::max(q.origin[r->iv], far[r->iv]);
+  return true;
+}
+
 }  // namespace render
 }  // namespace hybrid_vo

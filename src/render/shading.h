@@ -32,6 +32,24 @@ double sample_texture(const Texture& tex, double tu, double tv, double dux, doub
 double shade(const Quad& q, const Eigen::Vector2d& uv, const Eigen::Vector3d& dX_dx,
              const Eigen::Vector3d& dX_dy, int max_anisotropy);
 
+// Sample (i, j) of a grid with ss samples per pixel looks through image point
+// ((i + 0.5) / ss - 0.5, (j + 0.5) / ss - 0.5).
+inline double sample_coord(int i, int ss) { return (i + 0.5) / ss - 0.5; }
+
+// Per-quad constants of the ray-plane test: the plane world[a] = plane, the quad's extent along
+// the two other world axes iu, iv, and the bounding box of the samples it may cover.
+struct QuadRaster {
+  int index = 0;
+  int a = 0, iu = 0, iv = 0;
+  double plane = 0.0;
+  double lo_u = 0.0, hi_u = 0.0, lo_v = 0.0, hi_v = 0.0;
+  int x0 = 0, x1 = -1, y0 = 0, y1 = -1;  // inclusive, in samples
+};
+
+// The plane and extent of quad `index` of `scene` (not its box); false when a camera at `centre`
+// is behind it (quads are one-sided: seen from the side their normal points to).
+bool quad_plane(const Scene& scene, int index, const Eigen::Vector3d& centre, QuadRaster* r);
+
 // The sensor: blur, noise and 8-bit quantisation of a CV_32FC1 radiance image.
 cv::Mat finish(cv::Mat radiance, const RenderOptions& options);
 

@@ -142,6 +142,12 @@ class VpTracker {
   int frames() const { return frame_; }
 
  private:
+  // Per direction (odometry frame; `valid` marks the usable ones) its track's index or -1: the
+  // nearest within association_angle_deg, one to one, among every track or only the confident.
+  std::vector<int> associate_with_tracks(const std::vector<Eigen::Vector3d>& directions,
+                                         const std::vector<char>& valid,
+                                         bool confident_only) const;
+
   VpTrackerOptions options_;
   std::vector<VpTrack> tracks_;
   int next_id_ = 0;
