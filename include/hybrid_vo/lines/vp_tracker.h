@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 
 #include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/lines/direction_association.h"  // VpObservation
 
 namespace hybrid_vo {
 
@@ -32,14 +33,6 @@ struct VpTrackerOptions {
   // sigma (degrees): no detection is trusted beyond what rounding and lens models allow.
   double default_sigma_deg = 1.0;
   double min_sigma_deg = 0.005;
-};
-
-// One VP seen in the current camera.
-struct VpObservation {
-  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // camera frame, any scale or sign
-  // Covariance of the unit direction in the camera frame (rad^2, tangent plane), e.g. from its
-  // segments (vp_direction_covariance). Zero: default_sigma_deg.
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 
 struct VpTrack {
