@@ -46,6 +46,12 @@ double median_motion_px(const std::vector<PointMatch>& matches) {
   return motion[motion.size() / 2];
 }
 
+OrientationFilterOptions orientation_options(const VisualOdometryOptions& options) {
+  OrientationFilterOptions o = options.orientation;
+  o.correct = options.anchor_orientation;
+  return o;
+}
+
 bool uses_vps(const RelativePoseEstimatorOptions& options) {
   for (const SolverInfo& info : solver_table())
     if (options.ransac.enabled[static_cast<int>(info.id)] && info.num_vps > 0) return true;
@@ -62,10 +68,6 @@ VisualOdometryOptions::VisualOdometryOptions() {
   estimator.vp_detection.min_long_inliers = 3;
   estimator.vp_detection.min_support_px = 150.0;
   estimator.junctions.length_fraction = 0.15;
-  // A scene direction does not go away: a track survives a few seconds unseen, and is not dropped
-  // for disagreeing with the odometry, which is what it exists to correct (anchor_orientation).
-  vp_tracker.max_misses = 60;
-  vp_tracker.max_gate_failures = 0;
 }
 
 const char* to_string(VoStatus status) {
@@ -93,7 +95,7 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
       klt_(options.klt, options.features.points.max_features),
       line_tracker_(options.line_tracking, options.features.lines),
-      vp_tracker_(options.vp_tracker),
+      orientation_(orientation_options(options)),
       offset_filter_(options.stereo_offset) {}
 
 VisualOdometry::~VisualOdometry() = default;
@@ -117,7 +119,7 @@ void VisualOdometry::restart() {
   angular_velocity_.setZero();
   klt_.reset();
   line_tracker_.reset();
-  vp_tracker_.reset();
+  orientation_.reset();
   keyframe_ = Keyframe();
   tracker_seeded_ = false;
 }
@@ -547,15 +549,14 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
     m.line_vp = vps.labels;
     if (options_.use_vp_tracker) {
       if (!tracker_seeded_) {
-        vp_tracker_.update(keyframe_.R_wc,
-                           vp_observations(keyframe_.camera.pinhole.K(), m, false,
-                                           options_.estimator.vp_detection.inlier_threshold_px /
-                                               3.0,
-                                           options_.estimator.ransac.vp_threshold_deg /
-                                               3.0));
+        orientation_.seed(keyframe_.R_wc, keyframe_.R_wc_covariance,
+                          vp_observations(keyframe_.camera.pinhole.K(), m, false,
+                                          options_.estimator.vp_detection.inlier_threshold_px /
+                                              3.0,
+                                          options_.estimator.ransac.vp_threshold_deg / 3.0));
         tracker_seeded_ = true;
       }
-      m.vp_priors = vp_tracker_.priors(keyframe_.R_wc, m.vps);
+      m.vp_priors = orientation_.priors(keyframe_.R_wc, keyframe_.R_wc_covariance, m.vps);
       for (const VpPrior& prior : m.vp_priors) r.vp_track_ids.push_back(prior.track_id);
     }
   }
@@ -587,42 +588,44 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   times.scale_ms = ms_since(refine_start);
   std::map<int64_t, Eigen::Vector3d> current3d = match_stereo();
   if (stereo) add_current_disparities(input, observed, current3d, &observations);
+  // Orientation: the pair's rotation, corrected (or overruled) by the map of directions.
   RelativePose pose = est.pose;
-  std::vector<VpObservation> seen;  // the VPs the pose accepts, as seen in image 2
-  if (options_.use_vp_tracker) {
-    // Each with the covariance of its fit to image 2's segments at the pair's measured segment
-    // noise.
-    TwoViewMatches inliers;
-    inliers.lines = m.lines;
-    inliers.line_vp = m.line_vp;
-    std::vector<int> kept(m.vps.size(), -1);
-    for (size_t k = 0; k < m.vps.size(); ++k) {
-      if (k < est.vp_inliers.size() && !est.vp_inliers[k]) continue;
-      kept[k] = static_cast<int>(inliers.vps.size());
-      inliers.vps.push_back(m.vps[k]);
-    }
-    for (int& label : inliers.line_vp) label = label >= 0 ? kept[label] : -1;
-    seen = vp_observations(input.camera.pinhole.K(), inliers, true, est.scales.line_vp_px,
-                           est.scales.vp_deg);
-  }
+  RelativePose scale_pose = est.pose;
   Eigen::Matrix3d R_wc = nearest_rotation(keyframe_.R_wc * pose.R.transpose());
-  {
-    // The pair's rotation error as a left increment of R (camera 2) is -R_wc times it in the
-    // odometry frame.
-    const double floor = options_.rotation_drift_floor_deg * M_PI / 180.0;
-    R_wc_covariance_ = keyframe_.R_wc_covariance + floor * floor * Eigen::Matrix3d::Identity();
-    if (est.covariance_valid)
-      R_wc_covariance_ += R_wc * est.covariance.topLeftCorner<3, 3>() * R_wc.transpose();
-  }
-  if (options_.use_vp_tracker && options_.anchor_orientation) {
-    r.anchoring = vp_tracker_.anchor(R_wc, R_wc_covariance_, seen);
-    R_wc_covariance_ = r.anchoring.covariance;
-    // The correction is the drift of earlier pairs, not this pair's motion: the translation
-    // stays as this pair's points fixed it (re-fitted under the anchored rotation, it was 37 ->
-    // 51 deg off on TUM fr3 structure_notexture).
-    if (r.anchoring.anchors > 0) {
-      R_wc = r.anchoring.R_world_from_camera;
+  const double floor = options_.orientation.drift_floor_deg * M_PI / 180.0;
+  R_wc_covariance_ = keyframe_.R_wc_covariance + floor * floor * Eigen::Matrix3d::Identity();
+  if (est.covariance_valid)
+    R_wc_covariance_ += R_wc * est.covariance.topLeftCorner<3, 3>() * R_wc.transpose();
+  if (options_.use_vp_tracker) {
+    PairRotation pair;
+    pair.R = est.pose.R;
+    if (est.covariance_valid) pair.covariance = est.covariance.topLeftCorner<3, 3>();
+    pair.segment_matches = static_cast<int>(m.lines.size());
+    pair.vp_inliers = est.num_vp_inliers;
+    // Each VP with the covariance of its fit to image 2's segments at the pair's measured
+    // segment noise.
+    pair.vps = vp_observations(input.camera.pinhole.K(), m, true, est.scales.line_vp_px,
+                               est.scales.vp_deg);
+    pair.vp_accepted = est.vp_inliers;
+    pair.keyframe_vps = vp_observations(keyframe_.camera.pinhole.K(), m, false,
+                                        est.scales.line_vp_px, est.scales.vp_deg);
+    pair.points = &m.points;
+    pair.camera1 = keyframe_.camera.pinhole;
+    pair.camera2 = input.camera.pinhole;
+    pair.point_inliers = est.num_point_inliers;
+    r.orientation = orientation_.estimate(keyframe_.R_wc, keyframe_.R_wc_covariance, pair);
+    R_wc_covariance_ = r.orientation.covariance;
+    // A correction is the drift of earlier pairs, not this pair's motion: the translation stays
+    // as this pair's points fixed it (re-fitted under the anchored rotation, it was 37 -> 51 deg
+    // off on TUM fr3 structure_notexture). A rejected pair's rotation was wrong: its translation
+    // is fitted again under the map's.
+    if (r.orientation.source != OrientationSource::kPair) {
+      R_wc = r.orientation.R_world_from_camera;
       pose.R = nearest_rotation(R_wc.transpose() * keyframe_.R_wc);
+    }
+    if (r.orientation.source == OrientationSource::kPairRejected) {
+      pose.t = r.orientation.refit.pose.t;
+      scale_pose = pose;
     }
   }
 
@@ -639,10 +642,10 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
     // The pair's own pose: its rotation and translation explain its points together, and the
     // scale is fitted to those points (with the anchored rotation the demo's ATE was 0.0135 m
     // against 0.0115).
-    offset_filter_.update(est.pose, rig, r.scale_observations, options_.stereo_scale);
+    offset_filter_.update(scale_pose, rig, r.scale_observations, options_.stereo_scale);
     StereoScaleOptions scale_options = options_.stereo_scale;
     scale_options.disparity_offset_px = r.disparity_offset_px = offset_filter_.offset();
-    r.stereo_scale = estimate_stereo_scale(est.pose, rig, r.scale_observations, scale_options);
+    r.stereo_scale = estimate_stereo_scale(scale_pose, rig, r.scale_observations, scale_options);
     if (r.stereo_scale.status == StereoScaleStatus::kOk) {
       scale = r.stereo_scale.scale;
       scale_sigma = r.stereo_scale.sigma;
@@ -657,7 +660,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   }
 
   if (input.stamp > keyframe_.stamp) {
-    const Eigen::AngleAxisd turned(est.pose.R);
+    const Eigen::AngleAxisd turned(scale_pose.R);
     angular_velocity_ = turned.angle() * turned.axis() / (input.stamp - keyframe_.stamp);
   }
 
@@ -666,8 +669,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
   r.R_wc = R_wc_;
   r.centre = centre_;
-  // Every estimated frame, also without VPs, so that misses count.
-  if (options_.use_vp_tracker) r.vp_associations = vp_tracker_.update(R_wc_, seen);
+  if (options_.use_vp_tracker) orientation_.update(r.orientation);
   keep_as_keyframe(std::move(current3d));
   r.status = VoStatus::kOk;
   r.message = "ok";

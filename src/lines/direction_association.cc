@@ -212,40 +212,89 @@ double chi2_quantile_99(int dof) {
   return k * std::pow(1.0 - a + 2.3263 * std::sqrt(a), 3);
 }
 
+namespace {
+
+// The usable observations (finite, non-zero) as unit directions with world-frame covariances,
+// at most `max` of them, most certain first (the detector's order is arbitrary); `index` maps
+// back to the input.
+struct Prepared {
+  std::vector<int> index;
+  std::vector<Eigen::Vector3d> camera;
+  std::vector<Eigen::Matrix3d> world_covariance;
+};
+
+Prepared prepare(const Eigen::Matrix3d& R, const std::vector<VpObservation>& observations,
+                 int max) {
+  Prepared p;
+  for (size_t i = 0; i < observations.size(); ++i) {
+    const Eigen::Vector3d& d = observations[i].direction;
+    if (all_finite(d) && d.norm() > 0.0 && all_finite(observations[i].covariance))
+      p.index.push_back(static_cast<int>(i));
+  }
+  std::stable_sort(p.index.begin(), p.index.end(), [&](int a, int b) {
+    return observations[a].covariance.trace() < observations[b].covariance.trace();
+  });
+  if (static_cast<int>(p.index.size()) > max) p.index.resize(std::max(max, 0));
+  for (const int i : p.index) {
+    p.camera.push_back(observations[i].direction.normalized());
+    p.world_covariance.push_back(R * observations[i].covariance * R.transpose());
+  }
+  return p;
+}
+
+DirectionAssociation unchanged(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P, size_t n) {
+  DirectionAssociation out;
+  out.landmark.assign(n, -1);
+  out.R_world_from_camera = R;
+  out.covariance = P;
+  return out;
+}
+
+// The result of an accepted hypothesis.
+void accept(const Eigen::Matrix3d& R, const Prepared& p,
+            const std::vector<std::pair<int, int>>& pairs, const Fit& fit,
+            DirectionAssociation* out) {
+  for (const auto& [i, j] : pairs) out->landmark[p.index[i]] = j;
+  out->paired = static_cast<int>(pairs.size());
+  out->R_world_from_camera = nearest_rotation(exp_so3(fit.delta) * R);
+  out->covariance = fit.covariance;
+  out->joint_chi2 = fit.chi2;
+}
+
+}  // namespace
+
+DirectionAssociation fit_directions(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
+                                    const std::vector<VpObservation>& observations,
+                                    const std::vector<MapLandmark>& landmarks,
+                                    const std::vector<int>& pairing) {
+  DirectionAssociation out = unchanged(R, P, observations.size());
+  if (!all_finite(R) || !all_finite(P)) return out;
+  const Prepared p = prepare(R, observations, static_cast<int>(observations.size()));
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t k = 0; k < p.index.size(); ++k) {
+    const int i = p.index[k];
+    if (static_cast<size_t>(i) < pairing.size() && pairing[i] >= 0 &&
+        pairing[i] < static_cast<int>(landmarks.size()))
+      pairs.emplace_back(static_cast<int>(k), pairing[i]);
+  }
+  if (pairs.empty()) return out;
+  const Fit fit = fit_pairs(R, P, p.camera, p.world_covariance, landmarks, pairs);
+  if (fit.valid && fit.chi2 <= chi2_quantile_99(2 * static_cast<int>(pairs.size())))
+    accept(R, p, pairs, fit, &out);
+  return out;
+}
+
 DirectionAssociation associate_directions(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                                           const std::vector<VpObservation>& observations,
                                           const std::vector<MapLandmark>& landmarks,
                                           const DirectionAssociationOptions& options) {
-  DirectionAssociation out;
-  out.landmark.assign(observations.size(), -1);
-  out.R_world_from_camera = R;
-  out.covariance = P;
+  DirectionAssociation out = unchanged(R, P, observations.size());
   if (!all_finite(R) || !all_finite(P) || landmarks.empty()) return out;
-
-  // The observations as unit directions with world-frame covariances, the first
-  // max_observations usable ones (most certain first: the detector's order is arbitrary).
-  std::vector<int> index;
-  for (size_t i = 0; i < observations.size(); ++i) {
-    const Eigen::Vector3d& d = observations[i].direction;
-    if (all_finite(d) && d.norm() > 0.0 && all_finite(observations[i].covariance))
-      index.push_back(static_cast<int>(i));
-  }
-  std::stable_sort(index.begin(), index.end(), [&](int a, int b) {
-    return observations[a].covariance.trace() < observations[b].covariance.trace();
-  });
-  if (static_cast<int>(index.size()) > options.max_observations)
-    index.resize(std::max(options.max_observations, 0));
-  std::vector<Eigen::Vector3d> camera;
-  std::vector<Eigen::Matrix3d> world_covariance;
-  for (const int i : index) {
-    camera.push_back(observations[i].direction.normalized());
-    world_covariance.push_back(R * observations[i].covariance * R.transpose());
-  }
-
+  const Prepared p = prepare(R, observations, options.max_observations);
   const std::vector<std::vector<int>> candidates =
-      candidates_of(R, P, camera, world_covariance, landmarks, options);
+      candidates_of(R, P, p.camera, p.world_covariance, landmarks, options);
   for (const std::vector<int>& c : candidates) out.candidates += !c.empty();
-  Search search(R, P, camera, world_covariance, landmarks, candidates);
+  Search search(R, P, p.camera, p.world_covariance, landmarks, candidates);
   search.run(0);
   out.hypotheses = search.evaluated;
   if (search.found.empty()) return out;
@@ -267,11 +316,7 @@ DirectionAssociation associate_directions(const Eigen::Matrix3d& R, const Eigen:
       return out;
     }
   }
-  for (const auto& [i, j] : best.pairs) out.landmark[index[i]] = j;
-  out.paired = static_cast<int>(best.pairs.size());
-  out.R_world_from_camera = nearest_rotation(R_best);
-  out.covariance = best.fit.covariance;
-  out.joint_chi2 = best.fit.chi2;
+  accept(R, p, best.pairs, best.fit, &out);
   return out;
 }
 

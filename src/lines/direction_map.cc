@@ -101,8 +101,41 @@ std::vector<MapLandmark> DirectionMap::landmarks(bool confirmed_only) const {
   return out;
 }
 
+bool DirectionMap::spread(const DirectionAssociation& a, const std::vector<int>& confirmed) const {
+  const double min_angle = options_.reacquisition_min_angle_deg * kDeg;
+  for (size_t i = 0; i < a.landmark.size(); ++i)
+    for (size_t j = i + 1; j < a.landmark.size(); ++j)
+      if (a.landmark[i] >= 0 && a.landmark[j] >= 0 &&
+          line_angle(directions_[confirmed[a.landmark[i]]].direction,
+                     directions_[confirmed[a.landmark[j]]].direction) >= min_angle)
+        return true;
+  return false;
+}
+
+bool DirectionMap::pinnable() const {
+  const double min_angle = options_.reacquisition_min_angle_deg * kDeg;
+  for (size_t i = 0; i < directions_.size(); ++i)
+    for (size_t j = i + 1; j < directions_.size(); ++j)
+      if (directions_[i].confirmed && directions_[j].confirmed &&
+          line_angle(directions_[i].direction, directions_[j].direction) >= min_angle)
+        return true;
+  return false;
+}
+
 MapLocation DirectionMap::locate(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                                  const std::vector<VpObservation>& observations) const {
+  return locate_with(R, P, observations, nullptr);
+}
+
+MapLocation DirectionMap::locate_known(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
+                                       const std::vector<VpObservation>& observations,
+                                       const std::vector<int>& direction_ids) const {
+  return locate_with(R, P, observations, &direction_ids);
+}
+
+MapLocation DirectionMap::locate_with(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
+                                      const std::vector<VpObservation>& observations,
+                                      const std::vector<int>* known_ids) const {
   MapLocation where;
   where.R_world_from_camera = R;
   where.covariance = P;
@@ -113,20 +146,56 @@ MapLocation DirectionMap::locate(const Eigen::Matrix3d& R, const Eigen::Matrix3d
   std::vector<int> confirmed;  // landmark -> index into directions_
   for (size_t j = 0; j < directions_.size(); ++j)
     if (directions_[j].confirmed) confirmed.push_back(static_cast<int>(j));
-  const DirectionAssociation a =
-      associate_directions(R, P, seen, landmarks(true), options_.association);
+  DirectionAssociation a;
+  if (known_ids) {
+    std::vector<int> pairing(seen.size(), -1);
+    for (size_t k = 0; k < seen.size(); ++k) {
+      const size_t i = index[k];
+      for (size_t l = 0; i < known_ids->size() && l < confirmed.size(); ++l)
+        if (directions_[confirmed[l]].id == (*known_ids)[i]) pairing[k] = static_cast<int>(l);
+    }
+    a = fit_directions(R, P, seen, landmarks(true), pairing);
+  } else {
+    a = associate_directions(R, P, seen, landmarks(true), options_.association);
+    // The orientation may be off by more than its covariance admits (a pair that was wrong and
+    // sure of itself): three directions that pair only under a grown uncertainty, two of them
+    // well apart, unambiguously, take it back. Not two: with junk VPs and few directions, two
+    // pair by chance under a wide prior (TUM's panels).
+    const double sigma = options_.reacquisition_sigma_deg * kDeg;
+    const int needed = options_.wide_reacquisition_pairs;
+    if (a.paired < needed && static_cast<int>(seen.size()) >= needed && sigma > 0.0) {
+      const DirectionAssociation wide = associate_directions(
+          R, P + sigma * sigma * Eigen::Matrix3d::Identity(), seen, landmarks(true),
+          options_.association);
+      // Only a drift of the order of that uncertainty: larger ones come with a grown covariance
+      // (blank walls), and a large correction from a wide prior is more often chance than drift.
+      const double wide_deg =
+          Eigen::AngleAxisd(wide.R_world_from_camera * R.transpose()).angle() / kDeg;
+      if (wide.paired >= needed && spread(wide, confirmed) &&
+          wide_deg <= options_.reacquisition_sigma_deg)
+        a = wide;
+    }
+  }
   where.ambiguous = a.ambiguous;
   where.rejected = a.paired == 0 && !a.ambiguous && a.candidates > 0;
   if (a.paired == 0) return where;
+  const double correction_deg =
+      Eigen::AngleAxisd(a.R_world_from_camera * R.transpose()).angle() / kDeg;
+  // A re-acquisition needs two directions well apart: one fixes only two degrees of freedom,
+  // and after tens of degrees of drift a single VP may be any of the map's directions.
+  if (correction_deg > options_.reacquisition_deg && !spread(a, confirmed)) {
+    where.rejected = true;
+    return where;
+  }
   for (size_t k = 0; k < seen.size(); ++k)
     if (a.landmark[k] >= 0) where.direction_id[index[k]] = directions_[confirmed[a.landmark[k]]].id;
   where.paired = a.paired;
+  where.pinned = spread(a, confirmed);
   where.corrected = true;
   where.R_world_from_camera = a.R_world_from_camera;
   where.covariance = a.covariance;
   where.joint_chi2 = a.joint_chi2;
-  where.correction_deg =
-      Eigen::AngleAxisd(a.R_world_from_camera * R.transpose()).angle() / kDeg;
+  where.correction_deg = correction_deg;
   where.reacquired = where.correction_deg > options_.reacquisition_deg;
   return where;
 }
@@ -192,7 +261,13 @@ void DirectionMap::update(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
   if (location.ambiguous || location.rejected) ++stats_.rejected;
   std::vector<int> index;
   const std::vector<VpObservation> seen = usable(observations, &index);
-  const bool certain = largest_sigma(P) <= options_.max_orientation_sigma_deg * kDeg;
+  // New directions, candidates' observations and disagreements are registered against the
+  // directions the map already holds: only in a frame that two of them, well apart, located
+  // (or while the map has no two such), under a certain orientation. Else a drifted orientation
+  // would place copies of the map's directions a few degrees off, which would then hold the
+  // drift (one direction leaves the rotation about it free).
+  const bool certain = largest_sigma(P) <= options_.max_orientation_sigma_deg * kDeg &&
+                       (location.pinned || !pinnable());
   const double gate = chi2_quantile_99(2);
   std::vector<char> disagrees(directions_.size(), 0);
   for (size_t k = 0; k < seen.size(); ++k) {

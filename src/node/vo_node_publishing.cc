@@ -1,5 +1,7 @@
 // The node's outputs of the motion: ~relative_pose, tf, ~odometry, ~path and ~vanishing_points
 // (DESIGN.md, "The node"; as viso2_ros's odometer base class publishes tf and odometry).
+#include <algorithm>
+
 #include <Eigen/Geometry>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -192,23 +194,27 @@ Eigen::Matrix3d VoNode::R_odom_world() const {
 }
 
 void VoNode::publish_vanishing_points(const ros::Time& stamp, const VisualOdometryResult& result) {
-  // Tracked VPs, in the odometry frame (the first camera's frame turned into odom_frame).
+  // The map's directions, in the odometry frame (the first camera's frame turned into
+  // odom_frame), each with its map id and whether this frame's VPs saw it.
   VanishingPoints vps;
   vps.header.stamp = stamp;
   vps.header.frame_id = params_.odom_frame;
-  for (const VpTrack& track : vo_->vp_tracker().tracks()) {
+  const DirectionMap& map = vo_->direction_map();
+  const std::vector<int>& seen = result.orientation.location.direction_id;
+  for (const MapDirection& d : map.directions()) {
     VanishingPoint vp;
-    vp.id = track.id;
-    vp.direction_odom = to_vector(R_odom_world() * track.direction);
-    vp.direction_camera = to_vector(result.R_wc.transpose() * track.direction);
-    vp.hits = track.hits;
-    vp.age = track.age;
-    vp.confident = track.confident;
-    vp.sigma_deg = track.sigma_deg();
-    vp.last_chi2 = track.last_chi2;
-    vp.last_gate_passed = track.last_gate_passed;
-    vp.gate_failures = track.gate_failures;
-    vp.total_gate_failures = track.total_gate_failures;
+    vp.id = d.id;
+    vp.direction_odom = to_vector(R_odom_world() * d.direction);
+    vp.direction_camera = to_vector(result.R_wc.transpose() * d.direction);
+    vp.hits = d.hits;
+    vp.age = map.frames() - d.created;
+    vp.confident = d.confirmed;
+    vp.seen = std::find(seen.begin(), seen.end(), d.id) != seen.end();
+    vp.sigma_deg = d.sigma_deg();
+    vp.last_chi2 = d.last_chi2;
+    vp.last_gate_passed = d.disagreements == 0;
+    vp.gate_failures = d.disagreements;
+    vp.total_gate_failures = d.total_disagreements;
     vps.vps.push_back(vp);
   }
   vps_pub_.publish(vps);

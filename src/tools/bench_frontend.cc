@@ -163,6 +163,8 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--no-anchor") o.anchor_orientation = false;
+    else if (a == "--drift-floor" && i + 1 < argc)
+      o.orientation.drift_floor_deg = std::atof(argv[++i]);
     else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
@@ -344,6 +346,22 @@ int run(int argc, char** argv) {
           const Eigen::Vector3d w = (gt[i].R_wc * v.d2).normalized().cwiseAbs();
           std::printf(" %.3f", std::acos(std::min(1.0, w.maxCoeff())) * 180.0 / M_PI);
         }
+        // Each VP as a direction of the ground truth's world (sign: largest component positive),
+        // with its segments: where the scene's directions are and how much the VPs scatter.
+        std::printf("\n   VP directions in the true world:");
+        for (size_t k = 0; k < r.matches.vps.size(); ++k) {
+          Eigen::Vector3d w = (gt[i].R_wc * r.matches.vps[k].d2).normalized();
+          int largest;
+          w.cwiseAbs().maxCoeff(&largest);
+          if (w[largest] < 0.0) w = -w;
+          int support = 0;
+          for (int label : r.matches.line_vp) support += label == static_cast<int>(k);
+          std::printf(" (%.4f %.4f %.4f; %d%s)", w.x(), w.y(), w.z(), support,
+                      k < r.estimate.estimate.vp_inliers.size() &&
+                              !r.estimate.estimate.vp_inliers[k]
+                          ? ", outlier"
+                          : "");
+        }
         // Anywhere: each VP match's disagreement with the true relative rotation, and its
         // number of segments.
         const int reference = frame_of(r.reference_stamp);
@@ -362,16 +380,27 @@ int run(int argc, char** argv) {
           }
         }
       }
-      std::printf("\n   tracks:");
-      for (const VpTrack& t : vo.vp_tracker().tracks()) {
-        // In a Manhattan world: the track's angle to the nearest world axis (odometry = camera 0).
+      std::printf("\n   orientation: %s%s, %d map directions paired, correction %.3f deg%s",
+                  to_string(r.orientation.source), r.orientation.blank_wall ? ", blank wall" : "",
+                  r.orientation.location.paired, r.orientation.correction_deg,
+                  r.orientation.location.ambiguous ? ", ambiguous" : "");
+      std::printf("\n   map:");
+      for (const MapDirection& t : vo.direction_map().directions()) {
+        // In a Manhattan world: the direction's angle to the nearest world axis (odometry = camera 0).
+        // Anywhere: the direction in the ground truth's world (compare with the VPs' there).
         double axis_error = NAN;
+        Eigen::Vector3d world = Eigen::Vector3d::Constant(NAN);
         if (!gt.empty()) {
-          const Eigen::Vector3d w = (gt[0].R_wc * t.direction).normalized().cwiseAbs();
-          axis_error = std::acos(std::min(1.0, w.maxCoeff())) * 180.0 / M_PI;
+          world = (gt[0].R_wc * t.direction).normalized();
+          int largest;
+          const double m = world.cwiseAbs().maxCoeff(&largest);
+          if (world[largest] < 0.0) world = -world;
+          axis_error = std::acos(std::min(1.0, m)) * 180.0 / M_PI;
         }
-        std::printf(" [%d: sigma %.4f, hits %d, chi2 %.2f%s, axis %.3f]", t.id, t.sigma_deg(),
-                    t.hits, t.last_chi2, t.last_gate_passed ? "" : " FAILED", axis_error);
+        std::printf(" [%d: sigma %.4f, hits %d, chi2 %.2f%s%s, axis %.3f, true world %.4f %.4f %.4f]",
+                    t.id, t.sigma_deg(), t.hits, t.last_chi2, t.confirmed ? "" : " candidate",
+                    t.disagreements ? " DISAGREES" : "", axis_error, world.x(), world.y(),
+                    world.z());
       }
       if (static_cast<int>(gt.size()) > i)
       {

@@ -71,6 +71,13 @@ DirectionAssociation associate_directions(const Eigen::Matrix3d& R, const Eigen:
                                           const std::vector<MapLandmark>& landmarks,
                                           const DirectionAssociationOptions& options = {});
 
+// The rotation fitted to known pairs, observation i with landmark pairing[i] (-1: none), without
+// a search: nothing is paired when they are jointly implausible under the prediction.
+DirectionAssociation fit_directions(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
+                                    const std::vector<VpObservation>& observations,
+                                    const std::vector<MapLandmark>& landmarks,
+                                    const std::vector<int>& pairing);
+
 // The 99 % quantile of the chi-square distribution with `dof` degrees of freedom.
 double chi2_quantile_99(int dof);
 

@@ -46,6 +46,13 @@ struct DirectionMapOptions {
   // A correction larger than this (degrees) counts as a re-acquisition: beyond what association
   // by a small angle could have found.
   double reacquisition_deg = 3.0;
+  // ... and needs two paired directions at least this far apart (degrees). Where the
+  // orientation's own covariance pairs fewer than wide_reacquisition_pairs, that many are also
+  // sought under this much more uncertainty (degrees, per axis), for a correction of at most as
+  // much: a wrong pair can be surer of itself than it should.
+  double reacquisition_min_angle_deg = 30.0;
+  double reacquisition_sigma_deg = 5.0;
+  int wide_reacquisition_pairs = 3;
   DirectionAssociationOptions association;
   DirectionStructureOptions structure;
 };
@@ -53,9 +60,11 @@ struct DirectionMapOptions {
 template <typename Visit>
 void visit_fields(DirectionMapOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(positive(), o.confirm_hits, o.max_candidate_misses, o.max_directions,
-                  o.max_orientation_sigma_deg, o.max_disagreements, o.default_sigma_deg);
+                  o.max_orientation_sigma_deg, o.max_disagreements, o.default_sigma_deg,
+                  o.wide_reacquisition_pairs);
   HYBRID_VO_FIELDS(non_negative(), o.min_separation_deg, o.min_direction_sigma_deg,
-                  o.min_sigma_deg, o.disagreement_angle_deg, o.reacquisition_deg);
+                  o.min_sigma_deg, o.disagreement_angle_deg, o.reacquisition_deg,
+                  o.reacquisition_min_angle_deg, o.reacquisition_sigma_deg);
   visit_fields(o.association, prefixed("association_", visit));
   visit_fields(o.structure, prefixed("structure_", visit));
 }
@@ -84,6 +93,7 @@ struct MapLocation {
   double correction_deg = 0.0;
   double joint_chi2 = 0.0;
   bool corrected = false;
+  bool pinned = false;      // two of the paired directions are well apart: all three axes fixed
   bool reacquired = false;  // corrected by more than reacquisition_deg
   bool ambiguous = false;   // two associations explained the observations alike: no correction
   bool rejected = false;    // an association was found but failed the joint gate: no correction
@@ -111,6 +121,12 @@ class DirectionMap {
   // (nothing paired, ambiguous, or failing the gate). Invalid R or P: unchanged, nothing paired.
   MapLocation locate(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                      const std::vector<VpObservation>& observations) const;
+
+  // The same with the pairs known (observation i with the direction of id direction_ids[i], -1:
+  // none), e.g. from the keyframe's view of the same VPs: the rotation fitted to them, no search.
+  MapLocation locate_known(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
+                           const std::vector<VpObservation>& observations,
+                           const std::vector<int>& direction_ids) const;
 
   // One frame: fuses the paired observations into their directions (under the located R, with
   // its covariance P), counts disagreements, starts or confirms directions from the unpaired
@@ -141,6 +157,14 @@ class DirectionMap {
   std::vector<VpObservation> usable(const std::vector<VpObservation>& observations,
                                            std::vector<int>* index) const;
   std::vector<MapLandmark> landmarks(bool confirmed_only) const;
+  // Whether two of the association's directions (indices into `confirmed`) are
+  // reacquisition_min_angle_deg apart.
+  bool spread(const DirectionAssociation& a, const std::vector<int>& confirmed) const;
+  // Whether the map holds two confirmed directions that far apart.
+  bool pinnable() const;
+  MapLocation locate_with(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
+                          const std::vector<VpObservation>& observations,
+                          const std::vector<int>* known_ids) const;
   void add_direction(const Eigen::Vector3d& world, const Eigen::Matrix3d& covariance);
   void fuse(MapDirection* direction, const Eigen::Vector3d& world,
             const Eigen::Matrix3d& covariance);
