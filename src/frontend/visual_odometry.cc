@@ -607,6 +607,13 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
     pair.vps = vp_observations(input.camera.pinhole.K(), m, true, est.scales.line_vp_px,
                                est.scales.vp_deg);
     pair.vp_accepted = est.vp_inliers;
+    if (input.stamp > keyframe_.stamp) {
+      const Eigen::Vector3d w = angular_velocity_ * (input.stamp - keyframe_.stamp);
+      pair.has_last_motion = true;
+      pair.last_motion_R = w.norm() > 0.0
+                               ? Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix()
+                               : Eigen::Matrix3d::Identity();
+    }
     pair.keyframe_vps = vp_observations(keyframe_.camera.pinhole.K(), m, false,
                                         est.scales.line_vp_px, est.scales.vp_deg);
     pair.points = &m.points;
@@ -659,7 +666,8 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
     r.motion_covariance_valid = true;
   }
 
-  if (input.stamp > keyframe_.stamp) {
+  // A coasted pair keeps the last rate: its own rotation is what could not be trusted.
+  if (input.stamp > keyframe_.stamp && r.orientation.source != OrientationSource::kCoasted) {
     const Eigen::AngleAxisd turned(scale_pose.R);
     angular_velocity_ = turned.angle() * turned.axis() / (input.stamp - keyframe_.stamp);
   }

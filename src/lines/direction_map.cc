@@ -267,7 +267,7 @@ void DirectionMap::update(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
   // would place copies of the map's directions a few degrees off, which would then hold the
   // drift (one direction leaves the rotation about it free).
   const bool certain = largest_sigma(P) <= options_.max_orientation_sigma_deg * kDeg &&
-                       (location.pinned || !pinnable());
+                       (location.paired > 0 || !pinnable());
   const double gate = chi2_quantile_99(2);
   std::vector<char> disagrees(directions_.size(), 0);
   for (size_t k = 0; k < seen.size(); ++k) {

@@ -27,6 +27,8 @@ const char* to_string(OrientationSource source) {
       return "map";
     case OrientationSource::kReacquired:
       return "re-acquired";
+    case OrientationSource::kCoasted:
+      return "coasted";
     case OrientationSource::kPairRejected:
       return "pair rejected";
   }
@@ -58,7 +60,14 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
     extra = std::hypot(options_.blank_wall_sigma_deg * kDeg,
                        options_.blank_wall_rotation_fraction * turned);
   }
-  predict(R1, P1, pair, extra, &e.R_world_from_camera, &e.covariance);
+  PairRotation coasted;
+  const bool coast = e.blank_wall && options_.coast_blank_walls && pair.has_last_motion;
+  if (coast) {
+    coasted = pair;
+    coasted.R = pair.last_motion_R;
+  }
+  predict(R1, P1, coast ? coasted : pair, extra, &e.R_world_from_camera, &e.covariance);
+  if (coast) e.source = OrientationSource::kCoasted;
   if (!all_finite(e.R_world_from_camera) || !all_finite(e.covariance)) return e;
   const Eigen::Matrix3d predicted = e.R_world_from_camera;
 

@@ -163,8 +163,11 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--no-anchor") o.anchor_orientation = false;
+    else if (a == "--coast") o.orientation.coast_blank_walls = true;
     else if (a == "--drift-floor" && i + 1 < argc)
       o.orientation.drift_floor_deg = std::atof(argv[++i]);
+    else if (a == "--direction-floor" && i + 1 < argc)
+      o.orientation.map.min_direction_sigma_deg = std::atof(argv[++i]);
     else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];

@@ -34,7 +34,7 @@ struct DirectionMapOptions {
   double min_separation_deg = 1.0;
   // A direction's sigma never drops below this (degrees): segments are not exactly straight, nor
   // parallel in the scene, and thousands of fused frames must not make a direction rigid.
-  double min_direction_sigma_deg = 0.05;
+  double min_direction_sigma_deg = 0.01;
   // An observation without a usable covariance gets this sigma; every one at least the floor.
   double default_sigma_deg = 1.0;
   double min_sigma_deg = 0.005;

@@ -33,6 +33,8 @@ struct OrientationFilterOptions {
   // angle it turned, so that the map can take the directions back after the turn.
   double blank_wall_sigma_deg = 2.0;
   double blank_wall_rotation_fraction = 0.5;
+  // Across a blank wall, the rotation of the last motion instead of the pair's (coasting).
+  bool coast_blank_walls = false;
   // The judge of a pair: its VPs that the keyframe saw as map directions locate the current
   // camera under this much uncertainty of the pair's rotation (degrees, per axis); the pair is
   // rejected when its rotation differs from that location beyond this chi-square (3 dof,
@@ -63,6 +65,9 @@ struct PairRotation {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int segment_matches = 0;
   int vp_inliers = 0;
+  // The rotation the camera's last rotation rate gives over this pair's interval, if known.
+  bool has_last_motion = false;
+  Eigen::Matrix3d last_motion_R = Eigen::Matrix3d::Identity();
   // Every VP of the pair as seen in the current image, and which of them the pose accepts; the
   // same VPs as the keyframe saw them.
   std::vector<VpObservation> vps;
@@ -79,6 +84,7 @@ enum class OrientationSource {
   kPair,          // the pair's rotation, the map seeing nothing to correct it with
   kMap,           // corrected by the map's directions
   kReacquired,    // corrected by more than a small angle: directions found again after drift
+  kCoasted,       // a blank wall: the last motion's rotation, its uncertainty grown
   kPairRejected,  // the map contradicted the pair's rotation: the map's, t fitted again
 };
 const char* to_string(OrientationSource source);
