@@ -39,7 +39,8 @@ uint8_t status_code(const VisualOdometryResult& r) {
 }
 
 // Matches, inliers, solver statistics and timings of a frame, into its message.
-void fill_statistics(const VisualOdometryResult& result, bool moved, MotionEstimate* rel) {
+void fill_statistics(const VisualOdometryResult& result, bool moved, int map_directions,
+                     MotionEstimate* rel) {
   const RelativePoseEstimate& est = result.estimate.estimate;
   rel->points = result.num_point_matches;
   rel->lines = result.num_line_matches;
@@ -49,6 +50,29 @@ void fill_statistics(const VisualOdometryResult& result, bool moved, MotionEstim
   rel->junction_inliers = est.num_junction_inliers;
   rel->vps = result.matches.vps.size();
   rel->vp_inliers = est.num_vp_inliers;
+  const OrientationEstimate& o = result.orientation;
+  switch (o.source) {
+    case OrientationSource::kPair:
+      rel->orientation_source = MotionEstimate::ORIENTATION_PAIR;
+      break;
+    case OrientationSource::kMap:
+      rel->orientation_source = MotionEstimate::ORIENTATION_MAP;
+      break;
+    case OrientationSource::kReacquired:
+      rel->orientation_source = MotionEstimate::ORIENTATION_REACQUIRED;
+      break;
+    case OrientationSource::kCoasted:
+      rel->orientation_source = MotionEstimate::ORIENTATION_COASTED;
+      break;
+    case OrientationSource::kPairRejected:
+      rel->orientation_source = MotionEstimate::ORIENTATION_PAIR_REJECTED;
+      break;
+  }
+  rel->map_directions_seen = o.location.paired;
+  rel->map_directions = map_directions;
+  rel->orientation_correction_deg = o.correction_deg;
+  rel->blank_wall = o.blank_wall;
+  rel->map_correction_rejected = o.location.ambiguous || o.location.rejected;
   for (const SolverInfo& info : solver_table()) {
     const SolverStatistics& s = est.solvers[static_cast<int>(info.id)];
     if (s.sampled == 0) continue;
@@ -106,7 +130,9 @@ void VoNode::publish_relative_pose(const Frame& frame, const VisualOdometryResul
     // uncertainty along t.
     for (int i = 0; i < 36; ++i) rel.covariance[i] = result.motion_covariance(i / 6, i % 6);
   }
-  fill_statistics(result, moved, &rel);
+  int confirmed = 0;
+  for (const MapDirection& d : vo_->direction_map().directions()) confirmed += d.confirmed;
+  fill_statistics(result, moved, confirmed, &rel);
   relative_pose_pub_.publish(rel);
 }
 

@@ -275,6 +275,8 @@ int run(int argc, char** argv) {
       stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0;
+  // How the map of world directions served the estimated frames (as eval_trajectory prints it).
+  int held = 0, reacquired = 0, rejected = 0, blank = 0, coasted = 0, overruled = 0;
   double lines_sum = 0.0, inliers_sum = 0.0;
   const auto run_start = std::chrono::steady_clock::now();
   for (int i = 0; i < frames; ++i) {
@@ -431,6 +433,13 @@ int run(int argc, char** argv) {
     stereo_ms.push_back(r.stages.stereo_ms);
     if (r.status != VoStatus::kOk) continue;
     ++ok;
+    const OrientationSource source = r.orientation.source;
+    held += source == OrientationSource::kMap || source == OrientationSource::kReacquired;
+    reacquired += source == OrientationSource::kReacquired;
+    coasted += source == OrientationSource::kCoasted;
+    overruled += source == OrientationSource::kPairRejected;
+    rejected += r.orientation.location.ambiguous || r.orientation.location.rejected;
+    blank += r.orientation.blank_wall;
     if (stereo)
       scaled.push_back(r.stereo_scale.status == StereoScaleStatus::kOk ? 1.0 : 0.0);
     line_matches.push_back(r.num_line_matches);
@@ -470,6 +479,12 @@ int run(int argc, char** argv) {
               "inliers)\n",
               median(junctions), median(junction_inliers), median(vp_matches),
               median(vp_inliers));
+  int confirmed = 0;
+  for (const MapDirection& d : vo.direction_map().directions()) confirmed += d.confirmed;
+  std::printf("# map of directions: %d confirmed directions at the end; of %d estimated frames "
+              "%d held by the map, %d re-acquisitions, %d corrections rejected, %d blank walls "
+              "(%d coasted), %d pairs overruled\n",
+              confirmed, ok, held, reacquired, rejected, blank, coasted, overruled);
   if (!pose_errors.empty()) {
     const evaluation::TrajectoryErrors te =
         evaluation::compare_trajectories(estimate, truth, !stereo, 0.01);
