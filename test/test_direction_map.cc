@@ -231,7 +231,7 @@ TEST(DirectionMap, DisagreeingVpsNeitherMoveThePoseNorTheDirection) {
   const Eigen::Vector3d off = rotation_about(kZ, 4.0 * kDeg) * kX;
   for (int k = 0; k < 12; ++k) {
     const Eigen::Matrix3d truth = camera_to_world(20.0 + k);
-    const std::vector<VpObservation> o = see_all(truth, {off}, 0.1, &rng);
+    const std::vector<VpObservation> o = see_all(truth, {kY, kZ, off}, 0.1, &rng);
     const MapLocation where = map.locate(truth, isotropic(0.05), o);
     EXPECT_LT(rotation_deg(where.R_world_from_camera, truth), 0.06);
     map.update(where.R_world_from_camera, where.covariance, o, where);
@@ -292,8 +292,9 @@ TEST(DirectionMap, BadInputChangesNothingAndNeverGivesNan) {
   EXPECT_TRUE(all_finite(where.R_world_from_camera));
   map.update(R, isotropic(0.01), bad, where);
   map.update(R, isotropic(0.01), {}, MapLocation());
-  // The huge but finite VP is a direction like any other; the map's own are unchanged.
-  ASSERT_EQ(map.directions().size(), before.size() + 1);
+  // The huge but finite VP is a direction like any other, but this frame located nothing, so it
+  // starts none; the map's own are unchanged.
+  ASSERT_EQ(map.directions().size(), before.size());
   for (size_t j = 0; j < before.size(); ++j) {
     EXPECT_TRUE(all_finite(map.directions()[j].direction));
     EXPECT_LT(angle_deg(map.directions()[j].direction, before[j].direction), 0.5);
@@ -316,6 +317,49 @@ TEST(DirectionMap, DirectionsStayWhileUnseenAndIdsAreNeverReused) {
   // A candidate seen once is forgotten after max_candidate_misses frames.
   build(&map, {}, map.options().max_candidate_misses + 1, &rng);
   EXPECT_TRUE(map.directions().empty());
+}
+
+// Fusion weighs each observation by its covariance: a certain one moves a direction more than an
+// uncertain one, and the direction's sigma shrinks as observations come in.
+TEST(DirectionMap, FusionWeighsByInformation) {
+  DirectionMap map;
+  const Eigen::Matrix3d R = Eigen::Matrix3d::Identity(), P = isotropic(0.0);
+  auto observe = [&](const Eigen::Vector3d& d, double sigma_deg) {
+    VpObservation o;
+    o.direction = d;
+    o.covariance = std::pow(sigma_deg * kDeg, 2) * (Eigen::Matrix3d::Identity() - d * d.transpose());
+    map.update(R, P, {o}, map.locate(R, P, {o}));
+  };
+  observe(kZ, 1.0);
+  const double first_sigma = map.directions()[0].sigma_deg();
+  const Eigen::Vector3d off = rotation_about(kX, 1.0 * kDeg) * kZ;
+  observe(off, 0.1);  // certain: the direction moves most of the way
+  EXPECT_GT(angle_deg(map.directions()[0].direction, kZ), 0.9);
+  EXPECT_LT(map.directions()[0].sigma_deg(), first_sigma / 5.0);
+  DirectionMap other;
+  map = other;
+  observe(kZ, 0.1);
+  observe(off, 1.0);  // uncertain: it hardly moves
+  EXPECT_LT(angle_deg(map.directions()[0].direction, kZ), 0.05);
+}
+
+// The map is bounded: beyond max_directions the least supported direction makes room, candidates
+// before confirmed ones.
+TEST(DirectionMap, CapOnTheNumberOfDirections) {
+  std::mt19937 rng(10);
+  DirectionMapOptions options;
+  options.max_directions = 5;
+  DirectionMap map(options);
+  build(&map, {kX, kY, kZ}, 5, &rng);
+  std::vector<Eigen::Vector3d> many = {kX, kY, kZ};
+  for (int k = 0; k < 6; ++k)
+    many.push_back(rotation_about(kY, (15.0 + 10.0 * k) * kDeg) * kX);
+  build(&map, many, 1, &rng);
+  EXPECT_EQ(map.directions().size(), 5u);
+  int confirmed = 0;
+  for (const MapDirection& d : map.directions()) confirmed += d.confirmed;
+  EXPECT_EQ(confirmed, 3);
+  EXPECT_GE(map.stats().dropped, 4);
 }
 
 TEST(DirectionStructure, OrthogonalityIsTestedUnderTheCovariances) {
