@@ -352,12 +352,13 @@ std::vector<bool> geometric_filter(const std::vector<LineSegment>& a,
 
 }  // namespace
 
-LineFeatures describe_line_segments(const cv::Mat& image, const std::vector<LineSegment>& segments,
+LineFeatures describe_line_segments(const GrayImage& image,
+                                    const std::vector<LineSegment>& segments,
                                     std::vector<int>* kept, const LineDescriptionOptions& options) {
   LineFeatures features;
   if (kept) kept->clear();
-  if (image.empty() || segments.empty() || image.cols < 2 || image.rows < 2) return features;
-  const cv::Mat gray = to_gray8(image);
+  const cv::Mat& gray = image.mat();
+  if (gray.empty() || segments.empty() || gray.cols < 2 || gray.rows < 2) return features;
   const int octaves = std::max(1, std::min(options.octaves, 5));
   // The descriptors' image: the first_octave-th level of a pyrDown pyramid. A pyrDown level maps
   // x to (x + 0.5) / 2 - 0.5.
@@ -459,10 +460,9 @@ LineMatchingOptions video_line_matching_options() {
   return options;
 }
 
-LineFeatures detect_line_features(const cv::Mat& image, const LineMatchingOptions& options) {
+LineFeatures detect_line_features(const GrayImage& image, const LineMatchingOptions& options) {
   if (image.empty()) return LineFeatures();
-  const cv::Mat gray = to_gray8(image);
-  return describe_line_segments(gray, detect_line_segments(gray, options.detection), nullptr,
+  return describe_line_segments(image, detect_line_segments(image, options.detection), nullptr,
                                 options.description);
 }
 

@@ -338,7 +338,8 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
     }
   }
   last_stamp_ = input.stamp;
-  const cv::Mat gray = to_gray8(input.image);
+  // Converted once: every stage takes this form.
+  const GrayImage gray(input.image);
   StageTimings& times = r.stages;
 
   // The second thread's queue, in order: the stereo pair's pyramids, the segments, then its share
@@ -357,8 +358,8 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
     pair.camera = input.camera.pinhole;
     pair.baseline_m = input.baseline_m;
     pyramids_job = worker_->submit([&] {
-      pair.right = stereo_pyramid(to_gray8(input.right_image), options_.stereo);
-      if (!klt_pyramid) pair.left = stereo_pyramid(gray, options_.stereo);
+      pair.right = stereo_pyramid(GrayImage(input.right_image).mat(), options_.stereo);
+      if (!klt_pyramid) pair.left = stereo_pyramid(gray.mat(), options_.stereo);
     });
   }
   std::map<int64_t, Eigen::Vector2d> points;
@@ -455,7 +456,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
     if (tracking && stereo)
       for (const int64_t id : klt_.ids())
         if (!points.count(id)) pending.push_back(id);
-    make_keyframe(input, gray, tracking ? klt_points() : points, std::move(points3d),
+    make_keyframe(input, gray.mat(), tracking ? klt_points() : points, std::move(points3d),
                   std::move(features), line_ids, std::move(pair), std::move(pending));
   };
   // A frame that is not kept: its stereo matching is left undone.
@@ -582,8 +583,8 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   std::vector<int64_t> observed;
   const auto refine_start = std::chrono::steady_clock::now();
   if (stereo)
-    observations = scale_observations(input, gray, m, point_ids, est.point_inliers, points,
-                                      tracking, &observed);
+    observations = scale_observations(input, gray.mat(), m, point_ids, est.point_inliers,
+                                      points, tracking, &observed);
   times.scale_ms = ms_since(refine_start);
   std::map<int64_t, Eigen::Vector3d> current3d = match_stereo();
   if (stereo) add_current_disparities(input, observed, current3d, &observations);
