@@ -15,7 +15,7 @@ cv::Mat to_gray8(const cv::Mat& image);
 class GrayImage {
  public:
   GrayImage() = default;
-  GrayImage(const cv::Mat& image) : gray_(to_gray8(image)) {}  // NOLINT(runtime/explicit)
+  GrayImage(const cv::Mat& image) : gray_(to_gray8(image)) {}  // implicit: see above
   const cv::Mat& mat() const { return gray_; }
   bool empty() const { return gray_.empty(); }
 
