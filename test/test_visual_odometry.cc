@@ -1,5 +1,5 @@
 // The video front end on a rendered sequence: the threaded front end gives exactly the matches
-// and poses of the sequential one, segment tracking is as correct as full LBD matching without
+// and poses of the sequential one, colour frames those of grey ones, segment tracking is as correct as full LBD matching without
 // using any point, the stereo scale's current points do not lag on approaching
 // surfaces, the KLT tracker split over threads tracks as the sequential one, and the worker
 // thread and the tracker behave at their edges.
@@ -96,31 +96,45 @@ bool same_lines(const std::vector<LineMatch>& a, const std::vector<LineMatch>& b
   return true;
 }
 
-// Runs the whole sequence twice, threaded and sequential, and compares frame by frame.
-void expect_threaded_equals_sequential(const std::vector<VisualOdometryInput>& inputs,
-                                       bool track_lines) {
-  VisualOdometryOptions threaded, sequential;
-  threaded.track_lines = sequential.track_lines = track_lines;
-  threaded.concurrent = true;
-  sequential.concurrent = false;
-  VisualOdometry a(threaded), b(sequential);
+// Runs `inputs_a` through `a` and `inputs_b` through `b` and compares frame by frame: the same
+// statuses, matches, map directions, motions and poses, digit for digit.
+void expect_same_odometry(VisualOdometry& a, const std::vector<VisualOdometryInput>& inputs_a,
+                          VisualOdometry& b, const std::vector<VisualOdometryInput>& inputs_b) {
+  ASSERT_EQ(inputs_a.size(), inputs_b.size());
   int estimated = 0, with_lines = 0;
-  for (size_t i = 0; i < inputs.size(); ++i) {
-    const VisualOdometryResult ra = a.process(inputs[i]);
-    const VisualOdometryResult rb = b.process(inputs[i]);
+  for (size_t i = 0; i < inputs_a.size(); ++i) {
+    const VisualOdometryResult ra = a.process(inputs_a[i]);
+    const VisualOdometryResult rb = b.process(inputs_b[i]);
     ASSERT_EQ(ra.status, rb.status) << "frame " << i;
     EXPECT_TRUE(same_points(ra.matches.points, rb.matches.points)) << "frame " << i;
     EXPECT_TRUE(same_lines(ra.matches.lines, rb.matches.lines)) << "frame " << i;
     EXPECT_EQ(ra.num_line_matches, rb.num_line_matches) << "frame " << i;
+    EXPECT_EQ(ra.vp_track_ids, rb.vp_track_ids) << "frame " << i;
+    EXPECT_EQ(ra.orientation.source, rb.orientation.source) << "frame " << i;
+    EXPECT_EQ(ra.orientation.location.direction_id, rb.orientation.location.direction_id)
+        << "frame " << i;
+    EXPECT_EQ(ra.motion.R, rb.motion.R) << "frame " << i;
+    EXPECT_EQ(ra.motion.t, rb.motion.t) << "frame " << i;
     EXPECT_EQ(ra.R_wc, rb.R_wc) << "frame " << i;
     EXPECT_EQ(ra.centre, rb.centre) << "frame " << i;
     EXPECT_EQ(ra.scale_known, rb.scale_known) << "frame " << i;
+    EXPECT_EQ(ra.scale_observations.size(), rb.scale_observations.size()) << "frame " << i;
     estimated += ra.status == VoStatus::kOk;
     with_lines += ra.num_line_matches >= 20;
   }
   // The comparison means something only when frames were estimated with many segments.
-  EXPECT_GE(estimated, static_cast<int>(inputs.size()) / 2);
-  EXPECT_GE(with_lines, static_cast<int>(inputs.size()) / 2);
+  EXPECT_GE(estimated, static_cast<int>(inputs_a.size()) / 2);
+  EXPECT_GE(with_lines, static_cast<int>(inputs_a.size()) / 2);
+}
+
+// Runs the whole sequence twice, threaded and sequential, and compares frame by frame.
+void expect_threaded_equals_sequential(const std::vector<VisualOdometryInput>& inputs,
+                                       const VisualOdometryOptions& options) {
+  VisualOdometryOptions threaded = options, sequential = options;
+  threaded.concurrent = true;
+  sequential.concurrent = false;
+  VisualOdometry a(threaded), b(sequential);
+  expect_same_odometry(a, inputs, b, inputs);
 }
 
 TEST_F(VideoFrontEnd, ThreadedFrontEndGivesTheSequentialMatchesAndPoses) {
@@ -129,9 +143,28 @@ TEST_F(VideoFrontEnd, ThreadedFrontEndGivesTheSequentialMatchesAndPoses) {
     mono.push_back(input(i, false));
     stereo.push_back(input(i, true));
   }
-  expect_threaded_equals_sequential(mono, true);
-  expect_threaded_equals_sequential(mono, false);
-  expect_threaded_equals_sequential(stereo, true);
+  VisualOdometryOptions lbd, descriptors;
+  lbd.track_lines = false;
+  descriptors.point_source = PointFeatureSource::kDescriptors;
+  expect_threaded_equals_sequential(mono, VisualOdometryOptions());
+  expect_threaded_equals_sequential(mono, lbd);
+  expect_threaded_equals_sequential(stereo, VisualOdometryOptions());
+  expect_threaded_equals_sequential(stereo, descriptors);
+}
+
+// A colour camera's frames are converted to grey once, where they come in: BGR copies of the
+// grey frames (which cv::cvtColor turns back into the grey ones exactly) give their odometry.
+TEST_F(VideoFrontEnd, ColourFramesGiveTheGreyFramesOdometry) {
+  std::vector<VisualOdometryInput> grey, colour;
+  for (int i = 0; i < kFrames; ++i) {
+    grey.push_back(input(i, true));
+    VisualOdometryInput in = grey.back();
+    cv::cvtColor(grey.back().image, in.image, cv::COLOR_GRAY2BGR);
+    cv::cvtColor(grey.back().right_image, in.right_image, cv::COLOR_GRAY2BGR);
+    colour.push_back(in);
+  }
+  VisualOdometry a, b;
+  expect_same_odometry(a, colour, b, grey);
 }
 
 // Distance in pixels from the rendered ground truth: a keyframe segment's endpoints carried into

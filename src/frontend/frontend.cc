@@ -12,7 +12,7 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-ImageFeatures extract_features(const cv::Mat& image, const FrontendOptions& options) {
+ImageFeatures extract_features(const GrayImage& image, const FrontendOptions& options) {
   ImageFeatures f;
   if (options.use_points) {
     const auto start = std::chrono::steady_clock::now();

@@ -116,7 +116,7 @@ std::vector<char> KltTracker::predict(double motion_scale, std::vector<cv::Point
   return predicted;
 }
 
-std::vector<PointMatch> KltTracker::track(const cv::Mat& image, std::vector<int64_t>* ids,
+std::vector<PointMatch> KltTracker::track(const GrayImage& image, std::vector<int64_t>* ids,
                                           double stamp, const ParallelFor& parallel) {
   std::vector<PointMatch> matches = track_existing(image, ids, stamp, parallel);
   detect_new(parallel);
@@ -170,12 +170,13 @@ void KltTracker::search_range(const std::vector<cv::Mat>& pyramid, int begin, in
   search(pyramid, previous_, s->next, back_long, -1, options_, &s->back, &s->back_found);
 }
 
-std::vector<PointMatch> KltTracker::track_existing(const cv::Mat& image, std::vector<int64_t>* ids,
-                                                   double stamp, const ParallelFor& parallel) {
+std::vector<PointMatch> KltTracker::track_existing(const GrayImage& image,
+                                                   std::vector<int64_t>* ids, double stamp,
+                                                   const ParallelFor& parallel) {
   std::vector<PointMatch> matches;
   if (ids) ids->clear();
   if (image.empty()) return matches;
-  const cv::Mat gray = to_gray8(image);
+  const cv::Mat& gray = image.mat();
   if (!previous_.empty() && size_ != gray.size()) reset();
   // Each frame's pyramid (with the derivatives LK needs) is built once: it serves the forward
   // search into this frame, the backward search out of it, and the next frame's forward search.

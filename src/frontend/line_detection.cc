@@ -153,11 +153,11 @@ std::vector<LineSegment> merge_collinear_segments(std::vector<LineSegment> segme
   return merged;
 }
 
-std::vector<LineSegment> detect_line_segments(const cv::Mat& image,
+std::vector<LineSegment> detect_line_segments(const GrayImage& image,
                                               const LineDetectionOptions& options) {
   std::vector<LineSegment> segments;
   if (image.empty()) return segments;
-  const cv::Mat gray = to_gray8(image);
+  const cv::Mat& gray = image.mat();
 
   std::vector<cv::Vec4f> raw;
   const double gradient = line_gradient_threshold(gray, options);

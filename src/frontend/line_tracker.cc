@@ -31,6 +31,43 @@ bool near_prediction(const LineSegment& predicted, const LineSegment& c, double 
   return true;
 }
 
+// The segments of `segments` near `predicted` (near_prediction), in order.
+void find_candidates(const LineSegment& predicted, const std::vector<LineSegment>& segments,
+                     double tolerance, double cos_angle, double min_overlap,
+                     std::vector<Candidate>* candidates) {
+  candidates->clear();
+  for (int j = 0; j < static_cast<int>(segments.size()); ++j) {
+    Candidate c;
+    c.j = j;
+    if (near_prediction(predicted, segments[j], tolerance, cos_angle, min_overlap, &c.offset))
+      candidates->push_back(c);
+  }
+}
+
+// Of a track's ambiguous candidates, the nearest to its descriptor (row 0 of `descriptor`) by
+// LBD distance, when below the cap and below `ratio` times the second; -1 otherwise.
+int pick_by_descriptor(const cv::Mat& descriptor, const cv::Mat& descriptors,
+                       const std::vector<Candidate>& candidates,
+                       const LineTrackerOptions& options) {
+  float d_best = std::numeric_limits<float>::infinity();
+  float d_second = d_best;
+  int pick = -1;
+  for (const Candidate& c : candidates) {
+    const float d = line_descriptor_distance(descriptor, 0, descriptors, c.j);
+    if (d < d_best) {
+      d_second = d_best;
+      d_best = d;
+      pick = c.j;
+    } else if (d < d_second) {
+      d_second = d;
+    }
+  }
+  if (pick < 0 || !(d_best <= options.max_lbd_distance) ||
+      (std::isfinite(d_second) && d_best >= options.ratio * d_second))
+    return -1;
+  return pick;
+}
+
 // Both segments on one line (within `tolerance` px): fragments of one edge.
 bool same_line(const LineSegment& s, const LineSegment& t, double tolerance) {
   const Eigen::Vector3d ls = line_through(s.p1, s.p2), lt = line_through(t.p1, t.p2);
@@ -98,35 +135,38 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
   st.tracks = static_cast<int>(tracks_.size());
   const bool usable = all_finite(image_motion) && std::abs(image_motion.determinant()) > 1e-12;
   const Eigen::Matrix3d H = usable ? image_motion : Eigen::Matrix3d::Identity();
-
   const int n = static_cast<int>(current.segments.size());
   const bool descriptors = current.descriptors.rows == n && n > 0;
-  std::vector<int64_t> ids(n, -1);
+  Search s = search(current, now, H, descriptors, &st);
+  if (options_.reidentify && descriptors) reidentify(current, &s, &st);
+  return update_tracks(current, now, descriptors, s, &st);
+}
+
+LineTracker::Search LineTracker::search(const LineFeatures& current, double now,
+                                        const Eigen::Matrix3d& H, bool descriptors,
+                                        LineTrackingStats* st) const {
+  const int n = static_cast<int>(current.segments.size());
   const int m = static_cast<int>(tracks_.size());
-  std::vector<int> chosen(m, -1);
+  Search s;
+  s.chosen.assign(m, -1);
   std::vector<double> score(m, std::numeric_limits<double>::infinity());
   std::vector<Candidate> candidates;
-  std::vector<LineSegment> predictions(m), carried(m);
+  s.predictions.resize(m);
+  s.carried.resize(m);
   for (int k = 0; k < m; ++k) {
     const Track& t = tracks_[k];
-    if (!transfer(H, t.segment, &carried[k])) carried[k] = t.segment;
-    const LineSegment& predicted = predictions[k] = predict(t, now, H);
+    if (!transfer(H, t.segment, &s.carried[k])) s.carried[k] = t.segment;
+    const LineSegment& predicted = s.predictions[k] = predict(t, now, H);
     // The own motion's guess is uncertain by a fraction of it; the rotation's is not.
-    const double motion = std::max((predicted.p1 - carried[k].p1).norm(),
-                                   (predicted.p2 - carried[k].p2).norm());
+    const double motion = std::max((predicted.p1 - s.carried[k].p1).norm(),
+                                   (predicted.p2 - s.carried[k].p2).norm());
     const double tolerance = t.has_motion
                                  ? options_.max_offset_px + options_.motion_fraction * motion
                                  : options_.max_offset_young_px;
     const double cos_angle = std::cos(
         (t.has_motion ? options_.max_angle_deg : options_.young_angle_deg) * M_PI / 180.0);
-    candidates.clear();
-    for (int j = 0; j < n; ++j) {
-      Candidate c;
-      c.j = j;
-      if (near_prediction(predicted, current.segments[j], tolerance, cos_angle,
-                          options_.min_overlap, &c.offset))
-        candidates.push_back(c);
-    }
+    find_candidates(predicted, current.segments, tolerance, cos_angle, options_.min_overlap,
+                    &candidates);
     if (candidates.empty()) continue;
     const Candidate best = *std::min_element(
         candidates.begin(), candidates.end(),
@@ -140,82 +180,77 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
     if (ambiguous) {
       // Parallel edges near the prediction: the descriptor decides, or nobody does.
       if (!descriptors || t.descriptor.empty()) continue;
-      float d_best = std::numeric_limits<float>::infinity();
-      float d_second = d_best;
-      pick = -1;
-      for (const Candidate& c : candidates) {
-        const float d = line_descriptor_distance(t.descriptor, 0, current.descriptors, c.j);
-        if (d < d_best) {
-          d_second = d_best;
-          d_best = d;
-          pick = c.j;
-        } else if (d < d_second) {
-          d_second = d;
-        }
-      }
-      if (pick < 0 || !(d_best <= options_.max_lbd_distance) ||
-          (std::isfinite(d_second) && d_best >= options_.ratio * d_second))
-        continue;
-      ++st.ambiguous;
+      pick = pick_by_descriptor(t.descriptor, current.descriptors, candidates, options_);
+      if (pick < 0) continue;
+      ++st->ambiguous;
     }
-    chosen[k] = pick;
+    s.chosen[k] = pick;
     score[k] = std::find_if(candidates.begin(), candidates.end(),
                             [pick](const Candidate& c) { return c.j == pick; })
                    ->offset;
   }
 
   // One track per segment: the closest fit.
-  std::vector<int> owner(n, -1);
+  s.owner.assign(n, -1);
   for (int k = 0; k < m; ++k)
-    if (chosen[k] >= 0 && (owner[chosen[k]] < 0 || score[k] < score[owner[chosen[k]]]))
-      owner[chosen[k]] = k;
+    if (s.chosen[k] >= 0 && (s.owner[s.chosen[k]] < 0 || score[k] < score[s.owner[s.chosen[k]]]))
+      s.owner[s.chosen[k]] = k;
   for (int k = 0; k < m; ++k)
-    if (chosen[k] >= 0 && owner[chosen[k]] != k) chosen[k] = -1;
+    if (s.chosen[k] >= 0 && s.owner[s.chosen[k]] != k) s.chosen[k] = -1;
+  return s;
+}
 
-  // Re-identification of the tracks the search lost, among the segments it left: LBD matching
-  // of every described track against the whole frame, so that its geometric filter sees the
-  // context, of which only the lost tracks' pairs with free segments are taken. It runs when
-  // many are lost at once (a turn starting, a jolt), not for the few a steady frame loses.
-  if (options_.reidentify && descriptors) {
-    LineFeatures described;
-    std::vector<int> track_of_row;
-    int lost = 0;
-    for (int k = 0; k < m; ++k) {
-      const Track& t = tracks_[k];
-      if (t.descriptor.cols != current.descriptors.cols ||
-          t.descriptor.type() != current.descriptors.type())
-        continue;
-      described.segments.push_back(predictions[k]);
-      described.descriptors.push_back(t.descriptor);
-      track_of_row.push_back(k);
-      lost += chosen[k] < 0;
-    }
-    if (lost >= std::max<double>(options_.reidentify_min_lost,
-                         options_.reidentify_min_fraction * static_cast<double>(m))) {
-      std::vector<std::pair<int, int>> pairs;
-      match_line_features(described, current, matching_, &pairs);
-      for (const auto& [row, j] : pairs) {
-        const int k = track_of_row[row];
-        if (chosen[k] >= 0 || owner[j] >= 0) continue;
-        chosen[k] = j;
-        owner[j] = k;
-        ++st.reidentified;
-      }
-    }
+void LineTracker::reidentify(const LineFeatures& current, Search* s,
+                             LineTrackingStats* st) const {
+  // LBD matching of every described track against the whole frame, so that its geometric filter
+  // sees the context, of which only the lost tracks' pairs with free segments are taken. It runs
+  // when many are lost at once (a turn starting, a jolt), not for the few a steady frame loses.
+  const int m = static_cast<int>(tracks_.size());
+  LineFeatures described;
+  std::vector<int> track_of_row;
+  int lost = 0;
+  for (int k = 0; k < m; ++k) {
+    const Track& t = tracks_[k];
+    if (t.descriptor.cols != current.descriptors.cols ||
+        t.descriptor.type() != current.descriptors.type())
+      continue;
+    described.segments.push_back(s->predictions[k]);
+    described.descriptors.push_back(t.descriptor);
+    track_of_row.push_back(k);
+    lost += s->chosen[k] < 0;
   }
+  if (lost < std::max<double>(options_.reidentify_min_lost,
+                              options_.reidentify_min_fraction * static_cast<double>(m)))
+    return;
+  std::vector<std::pair<int, int>> pairs;
+  match_line_features(described, current, matching_, &pairs);
+  for (const auto& [row, j] : pairs) {
+    const int k = track_of_row[row];
+    if (s->chosen[k] >= 0 || s->owner[j] >= 0) continue;
+    s->chosen[k] = j;
+    s->owner[j] = k;
+    ++st->reidentified;
+  }
+}
 
+std::vector<int64_t> LineTracker::update_tracks(const LineFeatures& current, double now,
+                                                bool descriptors, const Search& s,
+                                                LineTrackingStats* st) {
+  const int n = static_cast<int>(current.segments.size());
+  const int m = static_cast<int>(tracks_.size());
+  std::vector<int64_t> ids(n, -1);
   std::vector<Track> kept;
   kept.reserve(m + n);
   for (int k = 0; k < m; ++k) {
     Track t = tracks_[k];
-    const int j = chosen[k];
+    const int j = s.chosen[k];
     if (j < 0) {
       if (++t.missed > options_.max_missed_frames) {
-        ++st.dropped;
+        ++st->dropped;
         continue;
       }
       // Coasting: where it should be now, so that the next frame's rotation carries it on.
-      t.segment = predictions[k];
+      t.segment = s.predictions[k];
       t.seen_at = now;
       kept.push_back(t);
       continue;
@@ -226,7 +261,7 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
       // The motion beyond the rotation's: from the carried segment to the one seen.
       Eigen::Vector2d shift;
       double turn;
-      line_motion(carried[k], seen, &shift, &turn);
+      line_motion(s.carried[k], seen, &shift, &turn);
       t.shift = shift / dt;
       t.turn = turn / dt;
       t.has_motion = true;
@@ -237,7 +272,7 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
     if (descriptors) t.descriptor = current.descriptors.row(j).clone();
     ids[j] = t.id;
     kept.push_back(t);
-    ++st.matched;
+    ++st->matched;
   }
   for (int j = 0; j < n; ++j) {
     if (ids[j] >= 0) continue;
@@ -248,7 +283,7 @@ std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stam
     if (descriptors) t.descriptor = current.descriptors.row(j).clone();
     ids[j] = t.id;
     kept.push_back(t);
-    ++st.started;
+    ++st->started;
   }
   tracks_ = std::move(kept);
   return ids;

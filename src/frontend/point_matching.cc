@@ -100,10 +100,10 @@ PointMatchingOptions video_point_matching_options() {
   return options;
 }
 
-PointFeatures detect_point_features(const cv::Mat& image, const PointMatchingOptions& options) {
+PointFeatures detect_point_features(const GrayImage& image,
+                                    const PointMatchingOptions& options) {
   PointFeatures features;
   if (image.empty() || options.max_features <= 0) return features;
-  const cv::Mat gray = to_gray8(image);
   cv::Ptr<cv::Feature2D> detector;
   if (options.type == PointFeatureType::kSift) {
     detector = cv::SIFT::create(options.max_features, options.sift_octave_layers,
@@ -113,7 +113,7 @@ PointFeatures detect_point_features(const cv::Mat& image, const PointMatchingOpt
                                options.orb_levels, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
                                options.orb_fast_threshold);
   }
-  detector->detectAndCompute(gray, cv::noArray(), features.keypoints, features.descriptors);
+  detector->detectAndCompute(image.mat(), cv::noArray(), features.keypoints, features.descriptors);
   if (features.descriptors.rows != static_cast<int>(features.keypoints.size())) {
     features = PointFeatures();  // never hand out keypoints without their descriptors
   }

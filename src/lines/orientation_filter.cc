@@ -49,6 +49,14 @@ void OrientationFilter::predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d
   *P = 0.5 * (*P + P->transpose());
 }
 
+OrientationEstimate OrientationFilter::predict(const Eigen::Matrix3d& R1,
+                                               const Eigen::Matrix3d& P1,
+                                               const PairRotation& pair) const {
+  OrientationEstimate e;
+  predict(R1, P1, pair, 0.0, &e.R_world_from_camera, &e.covariance);
+  return e;
+}
+
 OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
                                                 const Eigen::Matrix3d& P1,
                                                 const PairRotation& pair) const {

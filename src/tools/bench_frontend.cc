@@ -47,7 +47,7 @@ void usage(const char* program) {
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
                "  the KLT corners' strength floor (0: every corner); --drop-leaving: KLT drops\n"
                "  the features predicted outside the image unsearched; --no-anchor: no orientation\n"
-               "  anchoring by the VP tracks. Default preset hybrid+junc.\n"
+               "  correction by the map of directions. Default preset hybrid+junc.\n"
                "  --opencv-threads N: OpenCV's own thread pool (cv::setNumThreads), as the node's\n"
                "  opencv_threads parameter; default 1 (none: the front end splits its work over\n"
                "  its two threads itself); -1 leaves OpenCV's default.\n"

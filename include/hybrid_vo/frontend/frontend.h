@@ -23,7 +23,8 @@ struct ImageFeatures {
   double points_ms = 0.0, lines_ms = 0.0;  // detection and description
 };
 
-ImageFeatures extract_features(const cv::Mat& image, const FrontendOptions& options = {});
+// Converted to grey once for both detectors.
+ImageFeatures extract_features(const GrayImage& image, const FrontendOptions& options = {});
 
 // Point and segment matches between two images, undistorted, in the estimator's input types.
 // `match_ms` receives the matching time when given.

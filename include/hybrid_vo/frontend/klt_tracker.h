@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/frontend/gray_image.h"
 #include "hybrid_vo/frontend/worker_thread.h"
 #include "hybrid_vo/geometry/option_fields.h"
 
@@ -87,15 +88,14 @@ class KltTracker {
   // `max_features` caps the features tracked (and so the matches per pair); VisualOdometry passes
   // its point features' cap, so that one number bounds the points whatever their source.
   explicit KltTracker(const KltTrackerOptions& options = {}, int max_features = 1000);
-  // Tracks the current features into `image` (grayscale) and re-detects: track_existing, then
-  // detect_new. Returns the matches between the previous frame and this one (pixels) and their
+  // Tracks the current features into `image` and re-detects: track_existing, then detect_new. Returns the matches between the previous frame and this one (pixels) and their
   // track ids. The first call (or the first after reset) returns no matches. `stamp` (seconds,
   // optional) scales the motion prediction when frames are not evenly spaced.
-  std::vector<PointMatch> track(const cv::Mat& image, std::vector<int64_t>* ids = nullptr,
+  std::vector<PointMatch> track(const GrayImage& image, std::vector<int64_t>* ids = nullptr,
                                 double stamp = kNoStamp, const ParallelFor& parallel = {});
   // The two halves of track, so that the re-detection, which only the next frame needs, can run
   // while the caller uses the matches. After track_existing, points() holds the tracked features.
-  std::vector<PointMatch> track_existing(const cv::Mat& image, std::vector<int64_t>* ids = nullptr,
+  std::vector<PointMatch> track_existing(const GrayImage& image, std::vector<int64_t>* ids = nullptr,
                                          double stamp = kNoStamp,
                                          const ParallelFor& parallel = {});
   // Fills the buckets of the last tracked image that have too few features; appends to points().

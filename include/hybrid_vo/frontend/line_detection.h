@@ -4,6 +4,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "hybrid_vo/frontend/gray_image.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 
 namespace hybrid_vo {
@@ -46,8 +47,8 @@ struct LineDetectionOptions {
   double merge_gap_px = 20.0;
 };
 
-// Line segments of a grayscale (or BGR, converted) image, in pixels. Empty for an empty image.
-std::vector<LineSegment> detect_line_segments(const cv::Mat& image,
+// Line segments of an image, in pixels. Empty for an empty image.
+std::vector<LineSegment> detect_line_segments(const GrayImage& image,
                                               const LineDetectionOptions& options = {});
 
 // The gradient threshold detect_line_segments uses for `image` (grey levels per pixel): the

@@ -79,11 +79,13 @@ struct LineFeatures {
 };
 
 // Detection (LSD or FLD) and description. Empty features for an empty image.
-LineFeatures detect_line_features(const cv::Mat& image, const LineMatchingOptions& options = {});
+LineFeatures detect_line_features(const GrayImage& image,
+                                  const LineMatchingOptions& options = {});
 // Description of given segments (e.g. a benchmark's detections). `kept` (optional) receives,
 // per row of the result, the index of its segment in `segments`. The returned segments may have
 // their endpoints swapped (the orientation above).
-LineFeatures describe_line_segments(const cv::Mat& image, const std::vector<LineSegment>& segments,
+LineFeatures describe_line_segments(const GrayImage& image,
+                                    const std::vector<LineSegment>& segments,
                                     std::vector<int>* kept = nullptr,
                                     const LineDescriptionOptions& options = {});
 

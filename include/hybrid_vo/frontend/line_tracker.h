@@ -89,6 +89,24 @@ class LineTracker {
   // Where track t lies at time `now`, its segment first carried by `image_motion`.
   static LineSegment predict(const Track& t, double now, const Eigen::Matrix3d& image_motion);
 
+  // One frame's search (track's steps): per track its prediction, its segment carried by the
+  // rotation alone and the segment it found (-1: none); per segment its track (-1: none).
+  struct Search {
+    std::vector<LineSegment> predictions, carried;
+    std::vector<int> chosen;
+    std::vector<int> owner;
+  };
+  // Each track's segment near its prediction (ambiguous ones told apart by the descriptor, when
+  // `descriptors`), then one track per segment: the closest fit.
+  Search search(const LineFeatures& current, double now, const Eigen::Matrix3d& H,
+                bool descriptors, LineTrackingStats* st) const;
+  // The tracks the search lost, re-identified by LBD among the segments it left.
+  void reidentify(const LineFeatures& current, Search* s, LineTrackingStats* st) const;
+  // The tracks found move on, the lost ones coast or are dropped, and the segments left start
+  // tracks; returns each segment's track id.
+  std::vector<int64_t> update_tracks(const LineFeatures& current, double now, bool descriptors,
+                                     const Search& s, LineTrackingStats* st);
+
   LineTrackerOptions options_;
   LineMatchingOptions matching_;
   std::vector<Track> tracks_;

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/estimation/matches.h"
+#include "hybrid_vo/frontend/gray_image.h"
 
 namespace hybrid_vo {
 
@@ -41,7 +42,8 @@ struct PointFeatures {
 };
 
 // Detection and description for wide-baseline matching. Empty features for an empty image.
-PointFeatures detect_point_features(const cv::Mat& image, const PointMatchingOptions& options = {});
+PointFeatures detect_point_features(const GrayImage& image,
+                                    const PointMatchingOptions& options = {});
 
 // Ratio-tested (and optionally mutual) nearest-neighbour matches, in pixels. `pairs` receives the
 // keypoint indices of each match when given.

@@ -16,9 +16,9 @@
 #include "hybrid_vo/frontend/stage_timings.h"
 #include "hybrid_vo/estimation/stereo_scale.h"
 #include "hybrid_vo/frontend/stereo.h"
+#include "hybrid_vo/frontend/vo_orientation.h"
 #include "hybrid_vo/frontend/worker_thread.h"
 #include "hybrid_vo/lines/two_view.h"
-#include "hybrid_vo/lines/orientation_filter.h"
 
 namespace hybrid_vo {
 
@@ -165,10 +165,10 @@ class VisualOdometry {
   void reset();
   // Starts a new keyframe chain at the next frame but keeps the pose: after a fault in the stream
   // (a time gap, a new image size, rejected frames) the motion across it is unknown, so nothing
-  // may be paired across it, yet the odometry goes on from where it was. VP tracks are dropped
-  // too: their directions would be compared under a rotation that no longer holds.
+  // may be paired across it, yet the odometry goes on from where it was. The map of directions is
+  // dropped too: its directions would be compared under a rotation that no longer holds.
   void restart();
-  const DirectionMap& direction_map() const { return orientation_.map(); }
+  const DirectionMap& direction_map() const { return orientation_.direction_map(); }
   const VisualOdometryOptions& options() const { return options_; }
 
  private:
@@ -181,6 +181,7 @@ class VisualOdometry {
     bool valid() const { return !left.empty() && !right.empty(); }
   };
 
+  // What the frames are paired with (vo_keyframe_policy.cc says when a frame becomes one).
   struct Keyframe {
     bool valid = false;
     double stamp = 0.0;
@@ -209,6 +210,57 @@ class VisualOdometry {
     std::unique_ptr<StereoMatcher> matcher;
     std::map<int64_t, Eigen::Vector3d> points() const;  // once every chunk is searched
   };
+
+  // One frame's state on its way through run_frame (vo_frame.h).
+  struct Frame;
+
+  // process() without the threads' CPU times (not named process*: callgrind's
+  // --toggle-collect='hybrid_vo::VisualOdometry::process*' would toggle twice). The frame's
+  // schedule: its stages in order, and which thread runs each.
+  VisualOdometryResult run_frame(const VisualOdometryInput& input);
+
+  // The stages, by file. visual_odometry.cc: the input checked (time going backwards resets),
+  // the image converted to grey once, the segments' motion predicted (false: invalid input);
+  // the orientation (VoOrientation) and the pose integrated.
+  bool begin_frame(Frame& f);
+  void orient(Frame& f);
+  void integrate(Frame& f);
+
+  // vo_tracking.cc: the frame's points and segments, their matches with the keyframe's, and the
+  // KLT re-detection for the next frame.
+  void track_segments(Frame& f);      // detected, described and tracked (the second thread)
+  void track_points(Frame& f);        // KLT (searches on both threads), external or descriptors
+  void match_points(Frame& f) const;  // with the keyframe's, and the parallax
+  void start_redetection(Frame& f);   // its cells shared by both threads
+  void finish_redetection(Frame& f);
+  void match_segments(Frame& f) const;
+  // Every feature the KLT tracker holds, by id.
+  std::map<int64_t, Eigen::Vector2d> klt_points() const;
+
+  // vo_keyframe_policy.cc: whether a frame is estimated, becomes the keyframe or is left out.
+  enum class Pairing {
+    kEstimate,     // estimated against the keyframe; kept as the next one when a pose is found
+    kNewKeyframe,  // the keyframe from now on, without a motion: first frame, too few matches
+    kSkip,         // left out, the keyframe staying: too little parallax
+  };
+  bool low_parallax(const Frame& f) const;
+  Pairing decide_keyframe(Frame& f) const;
+  VisualOdometryResult keep_as_keyframe(Frame& f);  // the frame's end: it becomes the keyframe
+  VisualOdometryResult skip_frame(Frame& f);        // the frame's end: the keyframe stays
+  // `points` with their stereo points matched so far; `pending` the ids still without (see
+  // Keyframe::stereo_pending).
+  void make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> points,
+                     std::vector<int64_t> pending);
+
+  // vo_estimation.cc: the pair's pose (false: none found).
+  bool estimate(Frame& f);
+
+  // vo_stereo_scale.cc: the stereo points of the frame and the keyframe, and the scale.
+  void build_stereo_pyramids(Frame& f) const;  // the second thread
+  void start_stereo(Frame& f);    // the searches, shared by both threads
+  void finish_stereo(Frame& f);   // (starts them if need be)
+  void observe_scale(Frame& f) const;
+  void fit_scale(Frame& f);
   // Of `points` (by id) in `pair`. With `predict` each search starts at the disparity of the
   // same id in the keyframe, when it has one.
   StereoFeatures stereo_features(const StereoPair& pair,
@@ -218,62 +270,30 @@ class VisualOdometry {
   // (timed by `clock`); the others can never be matched again, and leave the pending list.
   void complete_keyframe_stereo(const std::map<int64_t, Eigen::Vector2d>& tracked,
                                 WorkClock* clock);
-  // Point matches keyframe -> current frame (pixels) and their ids: by track id, or by
-  // descriptor (`descriptors`, ids are keyframe indices).
-  void match_points(const std::map<int64_t, Eigen::Vector2d>& points,
-                    const ImageFeatures& features, bool descriptors, TwoViewMatches* m,
-                    std::vector<int64_t>* point_ids) const;
-  // `points3d` are the stereo points of `points` matched so far; `pending` the ids still
-  // without (see Keyframe::stereo_pending).
-  void make_keyframe(const VisualOdometryInput& input, const cv::Mat& gray,
-                     const std::map<int64_t, Eigen::Vector2d>& points,
-                     std::map<int64_t, Eigen::Vector3d> points3d, ImageFeatures features,
-                     const std::vector<int64_t>& line_ids, StereoPair stereo,
-                     std::vector<int64_t> pending);
-
-  // process() without the threads' CPU times (not named process*: callgrind's
-  // --toggle-collect='hybrid_vo::VisualOdometry::process*' would toggle twice).
-  VisualOdometryResult run_frame(const VisualOdometryInput& input);
-
   // The scale's observations of an estimated pair: the keyframe's stereo points among the
   // pose's point inliers, seen again; `observed` receives their ids.
-  std::vector<StereoScaleObservation> scale_observations(
-      const VisualOdometryInput& input, const cv::Mat& gray, const TwoViewMatches& m,
-      const std::vector<int64_t>& point_ids, const std::vector<char>& inliers,
-      const std::map<int64_t, Eigen::Vector2d>& points, bool tracking,
-      std::vector<int64_t>* observed) const;
-  // Their current points (of KLT tracks `observed`, at `points` in this frame) re-tracked from
+  std::vector<StereoScaleObservation> scale_observations(const Frame& f,
+                                                         std::vector<int64_t>* observed) const;
+  // Their current points (of KLT tracks `observed`, at f.points in this frame) re-tracked from
   // the keyframe with an affine window (refine_tracks_affine), on both threads; the near ones
   // that cannot be are left out (of `observed` too).
   std::vector<StereoScaleObservation> refine_scale_points(
-      const VisualOdometryInput& input, const cv::Mat& gray,
-      const std::map<int64_t, Eigen::Vector2d>& points, std::vector<int64_t>* observed,
+      const Frame& f, std::vector<int64_t>* observed,
       std::vector<StereoScaleObservation> observations) const;
-  // This frame's disparities of the observations of `ids` (stereo_current_disparity), where
-  // `current3d` has them.
-  void add_current_disparities(const VisualOdometryInput& input, const std::vector<int64_t>& ids,
-                               const std::map<int64_t, Eigen::Vector3d>& current3d,
-                               std::vector<StereoScaleObservation>* observations) const;
-
-  // Every feature the KLT tracker holds, by id.
-  std::map<int64_t, Eigen::Vector2d> klt_points() const;
+  // This frame's disparities of the observations of f.observed (stereo_current_disparity),
+  // where f.points3d has them.
+  void add_current_disparities(Frame& f) const;
 
   VisualOdometryOptions options_;
   std::unique_ptr<WorkerThread> worker_;
   KltTracker klt_;
   LineTracker line_tracker_;
-  OrientationFilter orientation_;
+  VoOrientation orientation_;
   // Kept across reset(): the offset belongs to the rig, not to the trajectory.
   DisparityOffsetFilter offset_filter_;
   Keyframe keyframe_;
-  Eigen::Matrix3d R_wc_ = Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d R_wc_covariance_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   double last_stamp_ = -1e300;
-  bool tracker_seeded_ = false;
-  // The camera's last estimated rotation rate (rad/s, rotation vector of X2 = R X1 per second):
-  // the segments' motion prediction for the next frame.
-  Eigen::Vector3d angular_velocity_ = Eigen::Vector3d::Zero();
 };
 
 }  // namespace hybrid_vo

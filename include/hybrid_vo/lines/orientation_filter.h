@@ -109,6 +109,9 @@ class OrientationFilter {
   // Invalid input leaves the prediction as it is.
   OrientationEstimate estimate(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
                                const PairRotation& pair) const;
+  // The pair's prediction alone, without the map: its rotation and its covariance grown by it.
+  OrientationEstimate predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
+                              const PairRotation& pair) const;
   // Takes the frame into the map (after estimate, with its result).
   void update(const OrientationEstimate& estimate);
   // The map's first directions, from the first keyframe's VPs, seen at R with covariance P.

@@ -1,0 +1,65 @@
+#pragma once
+
+// Internal: one frame's state on its way through VisualOdometry::run_frame.
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "hybrid_vo/frontend/gray_image.h"
+#include "hybrid_vo/frontend/visual_odometry.h"
+
+namespace hybrid_vo {
+
+// What the stages of one frame read and write, in the order run_frame runs them; the result is
+// filled on the way. The second thread's handles come last: leaving the frame early destroys
+// them first, which waits for their work, and that uses the fields above.
+struct VisualOdometry::Frame {
+  explicit Frame(const VisualOdometryInput& in) : input(in) {}
+  Frame(const Frame&) = delete;
+  Frame& operator=(const Frame&) = delete;
+
+  const VisualOdometryInput& input;
+  const std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  VisualOdometryResult result;  // what process() returns; result.matches are the pair's
+  bool was_reset = false;       // time went backwards: the odometry starts again here
+
+  // The frame as it came in (begin_frame).
+  GrayImage gray;            // the image, converted once: every stage takes this form
+  bool tracking = false;     // points are KLT tracks (not external, not descriptors)
+  bool stereo = false;       // a right image with a baseline: metric scale
+  bool klt_pyramid = false;  // the KLT tracker's pyramid of the image serves the stereo matching
+  // How the segments move from the last frame as the camera turns at its last rate.
+  Eigen::Matrix3d segment_motion = Eigen::Matrix3d::Identity();
+
+  // Its features and their matches with the keyframe's (in result.matches).
+  std::map<int64_t, Eigen::Vector2d> points;  // by id; the tracked ones until re-detection
+  ImageFeatures features;                     // segments (and descriptor points)
+  std::vector<int64_t> line_ids;              // with track_lines: the track of each segment
+  std::vector<int64_t> point_ids;             // per point match: its id
+  double parallax = -1.0;  // median image motion of the point matches; -1 below 5 matches
+
+  // Stereo: the pair's pyramids, the frame's stereo points, the scale's observations.
+  StereoPair pair;
+  StereoFeatures current_stereo;
+  WorkClock stereo_clock;
+  bool stereo_started = false, stereo_finished = false;
+  std::map<int64_t, Eigen::Vector3d> points3d;  // the frame's stereo points, once finished
+  std::vector<StereoScaleObservation> scale_observations;
+  std::vector<int64_t> observed;  // the ids of the scale's observations
+
+  // The pair's orientation (orient): whether the estimator looked for VPs, and the outcome.
+  bool vps_detected = false;
+  VoOrientation::Oriented oriented;
+
+  // The KLT re-detection for the next frame.
+  KltDetection detection;
+  WorkClock redetect_clock;
+
+  // The second thread's work (see above).
+  WorkerJob pyramids_job, segments_job;
+  SharedLoop stereo_loop, redetection;
+};
+
+}  // namespace hybrid_vo

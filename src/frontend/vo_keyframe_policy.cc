@@ -1,0 +1,90 @@
+// VisualOdometry's keyframe policy: every frame is paired with the last keyframe. A frame becomes
+// the keyframe when its pose is found, and when a new chain starts at it (the first frame, or too
+// few matches to pair it); it is left out, the keyframe staying, when it moved too little for an
+// epipolar geometry (min_parallax_px) or no pose was found. Also what a keyframe keeps.
+#include <string>
+
+#include "vo_frame.h"
+
+namespace hybrid_vo {
+
+bool VisualOdometry::low_parallax(const Frame& f) const {
+  return f.parallax >= 0.0 && f.parallax < options_.min_parallax_px;
+}
+
+VisualOdometry::Pairing VisualOdometry::decide_keyframe(Frame& f) const {
+  VisualOdometryResult& r = f.result;
+  if (!keyframe_.valid) {
+    r.status = f.was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
+    r.message = f.was_reset ? "time went backwards: odometry reset" : "keyframe initialised";
+    r.reference_stamp = f.input.stamp;
+    return Pairing::kNewKeyframe;
+  }
+  r.reference_stamp = keyframe_.stamp;
+  if (r.num_point_matches < options_.min_point_matches &&
+      r.num_line_matches < options_.min_line_matches) {
+    r.status = VoStatus::kTooFewFeatures;
+    r.message = "too few matches (" + std::to_string(r.num_point_matches) + " points, " +
+                std::to_string(r.num_line_matches) + " segments): re-initialised";
+    return Pairing::kNewKeyframe;
+  }
+  if (low_parallax(f)) {
+    r.status = VoStatus::kLowParallax;
+    r.message = "median motion " + std::to_string(f.parallax) + " px";
+    return Pairing::kSkip;
+  }
+  return Pairing::kEstimate;
+}
+
+VisualOdometryResult VisualOdometry::keep_as_keyframe(Frame& f) {
+  finish_stereo(f);
+  finish_redetection(f);
+  // The features that keyframe a frame: all the tracker holds once it has re-detected; in stereo
+  // the new ones are pending.
+  std::vector<int64_t> pending;
+  if (f.tracking && f.stereo)
+    for (const int64_t id : klt_.ids())
+      if (!f.points.count(id)) pending.push_back(id);
+  make_keyframe(f, f.tracking ? klt_points() : std::move(f.points), std::move(pending));
+  VisualOdometryResult& r = f.result;
+  r.total_ms = ms_since(f.start);
+  if (r.status == VoStatus::kFirstFrame || r.status == VoStatus::kReset) r.frontend_ms = r.total_ms;
+  return std::move(r);
+}
+
+VisualOdometryResult VisualOdometry::skip_frame(Frame& f) {
+  // Its stereo matching is left undone.
+  f.stereo_loop.cancel();
+  finish_redetection(f);
+  f.result.total_ms = ms_since(f.start);
+  return std::move(f.result);
+}
+
+void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> points,
+                                   std::vector<int64_t> pending) {
+  const VisualOdometryInput& input = f.input;
+  keyframe_ = Keyframe();
+  keyframe_.valid = true;
+  keyframe_.stamp = input.stamp;
+  keyframe_.points = std::move(points);
+  keyframe_.points3d = std::move(f.points3d);
+  keyframe_.stereo = std::move(f.pair);
+  keyframe_.stereo_pending = std::move(pending);
+  for (size_t i = 0; i < f.line_ids.size() && i < f.features.lines.segments.size(); ++i)
+    keyframe_.tracked_lines[f.line_ids[i]] = f.features.lines.segments[i];
+  keyframe_.features = std::move(f.features);
+  keyframe_.camera = input.camera;
+  // A copy: the caller may reuse its image buffer for the next frame.
+  if (options_.stereo_refine_tracks && !input.right_image.empty())
+    keyframe_.image = f.gray.mat().clone();
+  keyframe_.R_wc = orientation_.R_wc();
+  keyframe_.R_wc_covariance = orientation_.covariance();
+  keyframe_.centre = centre_;
+  if (input.external.has_lines)
+    for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i)
+      keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];
+  keyframe_.points_undistorted = input.external.has_points && input.external.points_undistorted;
+  keyframe_.lines_undistorted = input.external.has_lines && input.external.lines_undistorted;
+}
+
+}  // namespace hybrid_vo

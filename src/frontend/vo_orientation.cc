@@ -1,0 +1,148 @@
+// The visual odometry's orientation: pair rotations chained, held by the map of world directions
+// (OrientationFilter); the map's priors and seeds; the rotation rate that predicts the segments'
+// motion.
+#include "hybrid_vo/frontend/vo_orientation.h"
+
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/geometry/rotation.h"
+#include "hybrid_vo/geometry/vp_covariance.h"
+
+namespace hybrid_vo {
+namespace {
+
+// The VPs of one image of a pair as the map's observations: each direction with the covariance
+// of its fit to that image's labelled segments (pixels, at `sigma_px` per segment) plus
+// `vp_sigma_deg` per axis, the pair's measured VP scale: the fit alone is optimistic (rendered
+// corridor: the fit says 0.02-0.1 degrees, the VPs are 0.05-0.3 degrees off the true axes).
+std::vector<VpObservation> vp_observations(const Eigen::Matrix3d& K, const TwoViewMatches& m,
+                                           bool second_image, double sigma_px,
+                                           double vp_sigma_deg) {
+  std::vector<std::vector<LineSegment>> segments(m.vps.size());
+  for (size_t i = 0; i < m.lines.size() && i < m.line_vp.size(); ++i)
+    if (m.line_vp[i] >= 0 && m.line_vp[i] < static_cast<int>(m.vps.size()))
+      segments[m.line_vp[i]].push_back(second_image ? m.lines[i].s2 : m.lines[i].s1);
+  std::vector<VpObservation> observations(m.vps.size());
+  for (size_t k = 0; k < m.vps.size(); ++k) {
+    observations[k].direction = second_image ? m.vps[k].d2 : m.vps[k].d1;
+    // Without a usable fit the covariance stays zero: the map's default sigma.
+    Eigen::Matrix3d covariance;
+    if (vp_measurement_covariance(K, segments[k], observations[k].direction, sigma_px,
+                                  vp_sigma_deg * M_PI / 180.0, &covariance))
+      observations[k].covariance = covariance;
+  }
+  return observations;
+}
+
+OrientationFilterOptions filter_options(const VisualOdometryOptions& options) {
+  OrientationFilterOptions o = options.orientation;
+  o.correct = options.anchor_orientation;
+  return o;
+}
+
+}  // namespace
+
+VoOrientation::VoOrientation(const VisualOdometryOptions& options)
+    : use_map_(options.use_vp_tracker),
+      seed_sigma_px_(options.estimator.vp_detection.inlier_threshold_px / 3.0),
+      seed_sigma_deg_(options.estimator.ransac.vp_threshold_deg / 3.0),
+      filter_(filter_options(options)) {}
+
+void VoOrientation::restart() {
+  angular_velocity_.setZero();
+  filter_.reset();
+  seeded_ = false;
+}
+
+void VoOrientation::reset() {
+  restart();
+  R_wc_.setIdentity();
+  covariance_.setZero();
+}
+
+Eigen::Matrix3d VoOrientation::segment_motion(const PinholeCamera& camera, double dt) const {
+  const Eigen::Vector3d w = angular_velocity_ * dt;
+  if (!(w.norm() > 0.0)) return Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d K = camera.K();
+  return K * Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix() * K.inverse();
+}
+
+std::vector<int> VoOrientation::add_vp_priors(const Eigen::Matrix3d& keyframe_R_wc,
+                                              const Eigen::Matrix3d& keyframe_covariance,
+                                              const Eigen::Matrix3d& keyframe_K,
+                                              TwoViewMatches* m) {
+  std::vector<int> direction_ids;
+  if (!use_map_) return direction_ids;
+  if (!seeded_) {
+    filter_.seed(keyframe_R_wc, keyframe_covariance,
+                 vp_observations(keyframe_K, *m, false, seed_sigma_px_, seed_sigma_deg_));
+    seeded_ = true;
+  }
+  m->vp_priors = filter_.priors(keyframe_R_wc, keyframe_covariance, m->vps);
+  for (const VpPrior& prior : m->vp_priors) direction_ids.push_back(prior.track_id);
+  return direction_ids;
+}
+
+VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_wc,
+                                              const Eigen::Matrix3d& keyframe_covariance,
+                                              const Pair& pair) const {
+  const RelativePoseEstimate& est = *pair.estimate;
+  const TwoViewMatches& m = *pair.matches;
+  PairRotation rotation;
+  rotation.R = est.pose.R;
+  if (est.covariance_valid) rotation.covariance = est.covariance.topLeftCorner<3, 3>();
+  rotation.segment_matches = static_cast<int>(m.lines.size());
+  rotation.vp_inliers = est.num_vp_inliers;
+  if (pair.dt > 0.0) {
+    const Eigen::Vector3d w = angular_velocity_ * pair.dt;
+    rotation.has_last_motion = true;
+    rotation.last_motion_R = w.norm() > 0.0 ? rotation_about(w.normalized(), w.norm())
+                                            : Eigen::Matrix3d::Identity();
+  }
+  Oriented o;
+  o.pose = o.scale_pose = est.pose;
+  if (!use_map_ || !pair.vps_detected) {
+    o.estimate = filter_.predict(keyframe_R_wc, keyframe_covariance, rotation);
+  } else {
+    // Each VP with the covariance of its fit to the segments at the pair's measured noise.
+    rotation.vps = vp_observations(pair.camera.K(), m, true, est.scales.line_vp_px,
+                                   est.scales.vp_deg);
+    rotation.vp_accepted = est.vp_inliers;
+    rotation.keyframe_vps = vp_observations(pair.keyframe_camera.K(), m, false,
+                                            est.scales.line_vp_px, est.scales.vp_deg);
+    rotation.points = &m.points;
+    rotation.camera1 = pair.keyframe_camera;
+    rotation.camera2 = pair.camera;
+    rotation.point_inliers = est.num_point_inliers;
+    o.estimate = filter_.estimate(keyframe_R_wc, keyframe_covariance, rotation);
+  }
+  o.R_wc = o.estimate.R_world_from_camera;
+  o.covariance = o.estimate.covariance;
+  // A correction is the drift of earlier pairs, not this pair's motion: the translation stays as
+  // this pair's points fixed it (re-fitted under the anchored rotation, it was 37 -> 51 deg off
+  // on TUM fr3 structure_notexture). A rejected pair's rotation was wrong: its translation was
+  // fitted again under the map's, and that pose also scales the motion.
+  if (o.estimate.source != OrientationSource::kPair)
+    o.pose.R = nearest_rotation(o.R_wc.transpose() * keyframe_R_wc);
+  if (o.estimate.source == OrientationSource::kPairRejected) {
+    o.pose.t = o.estimate.refit.pose.t;
+    o.scale_pose = o.pose;
+  }
+  return o;
+}
+
+void VoOrientation::advance(const Oriented& oriented, double dt) {
+  // A coasted pair keeps the last rate: its own rotation is what could not be trusted.
+  if (dt > 0.0 && oriented.estimate.source != OrientationSource::kCoasted) {
+    const Eigen::AngleAxisd turned(oriented.scale_pose.R);
+    angular_velocity_ = turned.angle() * turned.axis() / dt;
+  }
+  R_wc_ = oriented.R_wc;
+  covariance_ = oriented.covariance;
+  if (use_map_) filter_.update(oriented.estimate);
+}
+
+}  // namespace hybrid_vo

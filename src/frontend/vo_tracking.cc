@@ -1,0 +1,124 @@
+// VisualOdometry's features: the frame's points (KLT tracks, external or detected) and segments
+// (detected, described and tracked), their matches with the keyframe's, and the KLT
+// re-detection for the next frame.
+#include <algorithm>
+#include <chrono>
+
+#include "vo_frame.h"
+
+namespace hybrid_vo {
+namespace {
+
+// The median image motion of the point matches (pixels).
+double median_motion_px(const std::vector<PointMatch>& matches) {
+  std::vector<double> motion;
+  for (const PointMatch& p : matches) motion.push_back((p.x2 - p.x1).norm());
+  std::nth_element(motion.begin(), motion.begin() + motion.size() / 2, motion.end());
+  return motion[motion.size() / 2];
+}
+
+}  // namespace
+
+std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
+  std::map<int64_t, Eigen::Vector2d> points;
+  for (size_t i = 0; i < klt_.points().size(); ++i)
+    points[klt_.ids()[i]] = Eigen::Vector2d(klt_.points()[i].x, klt_.points()[i].y);
+  return points;
+}
+
+void VisualOdometry::track_segments(Frame& f) {
+  const auto lines_start = std::chrono::steady_clock::now();
+  f.features.lines = detect_line_features(f.gray, options_.features.lines);
+  if (options_.track_lines)
+    f.line_ids = line_tracker_.track(f.features.lines, f.input.stamp, &f.result.line_tracking,
+                                     f.segment_motion);
+  f.result.stages.lines_ms = ms_since(lines_start);
+}
+
+void VisualOdometry::track_points(Frame& f) {
+  const ExternalFeatures& external = f.input.external;
+  const auto points_start = std::chrono::steady_clock::now();
+  if (external.has_points) {
+    for (size_t i = 0; i < external.points.size() && i < external.point_ids.size(); ++i)
+      if (all_finite(external.points[i])) f.points[external.point_ids[i]] = external.points[i];
+  } else if (f.tracking) {
+    // The searches on both threads, the second once it has detected the segments.
+    klt_.track_existing(f.gray, nullptr, f.input.stamp, worker_->parallel());
+    f.points = klt_points();
+    if (f.klt_pyramid) f.pair.left = klt_.pyramid();
+  } else {
+    f.features.points = detect_point_features(f.gray, options_.features.points);
+    const std::vector<cv::KeyPoint>& keypoints = f.features.points.keypoints;
+    for (size_t i = 0; i < keypoints.size(); ++i)
+      f.points[static_cast<int64_t>(i)] = Eigen::Vector2d(keypoints[i].pt.x, keypoints[i].pt.y);
+  }
+  f.result.stages.points_ms = ms_since(points_start);
+}
+
+void VisualOdometry::match_points(Frame& f) const {
+  if (!keyframe_.valid) return;
+  // By track id, or by descriptor (descriptor points: their ids are keyframe indices).
+  std::vector<PointMatch>& matches = f.result.matches.points;
+  if (!f.input.external.has_points && !f.tracking) {
+    std::vector<std::pair<int, int>> pairs;
+    matches = match_point_features(keyframe_.features.points, f.features.points,
+                                   options_.features.points, &pairs);
+    for (const auto& p : pairs) f.point_ids.push_back(p.first);
+  } else {
+    for (const auto& [id, p] : f.points) {
+      const auto it = keyframe_.points.find(id);
+      if (it == keyframe_.points.end()) continue;
+      matches.push_back({it->second, p});
+      f.point_ids.push_back(id);
+    }
+  }
+  // Whether the frame moved enough to be estimated (low_parallax).
+  if (matches.size() >= 5) f.parallax = median_motion_px(matches);
+}
+
+void VisualOdometry::start_redetection(Frame& f) {
+  // The re-detection serves only the next frame: cell by cell on the second thread while this
+  // one estimates and fits the scale, and this one takes the cells left when it is done.
+  // f.points holds the tracked features until then.
+  if (!f.tracking) return;
+  f.detection = klt_.plan_detection();
+  f.redetection = worker_->share(f.detection.cells(), f.redetect_clock.timed([this, &f](int cell) {
+    klt_.detect_cell(&f.detection, cell);
+  }));
+}
+
+void VisualOdometry::finish_redetection(Frame& f) {
+  f.redetection.join();
+  if (f.tracking) klt_.add_detections(f.detection);
+  f.result.stages.redetect_ms = f.redetect_clock.ms();
+}
+
+void VisualOdometry::match_segments(Frame& f) const {
+  VisualOdometryResult& r = f.result;
+  TwoViewMatches& m = r.matches;
+  const ExternalFeatures& external = f.input.external;
+  if (external.has_lines) {
+    for (size_t i = 0; i < external.lines.size() && i < external.line_ids.size(); ++i) {
+      const auto it = keyframe_.external_lines.find(external.line_ids[i]);
+      if (it != keyframe_.external_lines.end()) m.lines.push_back({it->second, external.lines[i]});
+    }
+  } else if (options_.use_lines) {
+    const auto matching_start = std::chrono::steady_clock::now();
+    if (options_.track_lines) {
+      for (size_t i = 0; i < f.line_ids.size(); ++i) {
+        const auto it = keyframe_.tracked_lines.find(f.line_ids[i]);
+        if (it != keyframe_.tracked_lines.end())
+          m.lines.push_back({it->second, f.features.lines.segments[i]});
+      }
+    } else {
+      m.lines = match_line_features(keyframe_.features.lines, f.features.lines,
+                                    options_.features.lines);
+    }
+    r.stages.line_matching_ms = ms_since(matching_start);
+  }
+  r.num_point_matches = static_cast<int>(m.points.size());
+  r.num_line_matches = static_cast<int>(m.lines.size());
+  r.frontend_ms = ms_since(f.start);
+}
+
+}  // namespace hybrid_vo
