@@ -130,6 +130,8 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
   if (o.estimate.source == OrientationSource::kPairRejected) {
     o.pose.t = o.estimate.refit.pose.t;
     o.scale_pose = o.pose;
+  } else if (o.estimate.refit.ok) {
+    o.pose.t = o.estimate.refit.pose.t;  // translation_given_rotation
   }
   return o;
 }

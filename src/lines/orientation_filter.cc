@@ -98,9 +98,11 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
         const Eigen::AngleAxisd apart(judged.R_world_from_camera * predicted.transpose());
         const Eigen::Vector3d delta = apart.angle() * apart.axis();
         const Eigen::FullPivLU<Eigen::Matrix3d> lu(e.covariance + judged.covariance);
+        TranslationEstimate refit;
         if (lu.isInvertible() && delta.dot(lu.inverse() * delta) > options_.reject_chi2 &&
-            refit_translation(R1, judged.R_world_from_camera, pair, &e.refit)) {
+            refit_translation(R1, judged.R_world_from_camera, pair, &refit)) {
           e.source = OrientationSource::kPairRejected;
+          e.refit = refit;
           e.R_world_from_camera = judged.R_world_from_camera;
           e.covariance = judged.covariance;
           e.location = judged;
@@ -121,6 +123,9 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   e.covariance = e.location.covariance;
   e.source = e.location.reacquired ? OrientationSource::kReacquired : OrientationSource::kMap;
   e.correction_deg = angle_deg(e.R_world_from_camera, predicted);
+  if (options_.translation_given_rotation &&
+      !refit_translation(R1, e.R_world_from_camera, pair, &e.refit))
+    e.refit = TranslationEstimate();
   return e;
 }
 

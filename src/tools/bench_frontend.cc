@@ -164,6 +164,7 @@ int run(int argc, char** argv) {
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--no-anchor") o.anchor_orientation = false;
     else if (a == "--coast") o.orientation.coast_blank_walls = true;
+    else if (a == "--translation-given-rotation") o.orientation.translation_given_rotation = true;
     else if (a == "--drift-floor" && i + 1 < argc)
       o.orientation.drift_floor_deg = std::atof(argv[++i]);
     else if (a == "--direction-floor" && i + 1 < argc)

@@ -35,6 +35,9 @@ struct OrientationFilterOptions {
   double blank_wall_rotation_fraction = 0.5;
   // Across a blank wall, the rotation of the last motion instead of the pair's (coasting).
   bool coast_blank_walls = false;
+  // Where the map corrected the rotation, the pair's translation fitted again under it (points
+  // only, relpose_known_rotation_2pt); else the pair's own translation stays.
+  bool translation_given_rotation = false;
   // The judge of a pair: its VPs that the keyframe saw as map directions locate the current
   // camera under this much uncertainty of the pair's rotation (degrees, per axis); the pair is
   // rejected when its rotation differs from that location beyond this chi-square (3 dof,
@@ -50,7 +53,7 @@ struct OrientationFilterOptions {
 
 template <typename Visit>
 void visit_fields(OrientationFilterOptions& o, Visit&& visit) {
-  HYBRID_VO_FIELDS(any_value(), o.correct);
+  HYBRID_VO_FIELDS(any_value(), o.correct, o.coast_blank_walls, o.translation_given_rotation);
   HYBRID_VO_FIELDS(non_negative(), o.drift_floor_deg, o.blank_wall_max_segments,
                   o.blank_wall_sigma_deg, o.blank_wall_rotation_fraction);
   HYBRID_VO_FIELDS(positive(), o.judge_sigma_deg, o.reject_chi2);
@@ -97,7 +100,8 @@ struct OrientationEstimate {
   MapLocation location;     // of the pair's accepted VPs (or of every VP, when rejected)
   std::vector<VpObservation> observations;  // the VPs the map located the camera with
   double correction_deg = 0.0;  // from the pair's prediction
-  // kPairRejected: the pair's motion under the map's rotation, its translation fitted again.
+  // The pair's translation fitted again under the map's rotation: kPairRejected, and any
+  // correction with translation_given_rotation (refit.ok then).
   TranslationEstimate refit;
 };
 
