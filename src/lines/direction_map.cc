@@ -262,10 +262,10 @@ void DirectionMap::update(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
   std::vector<int> index;
   const std::vector<VpObservation> seen = usable(observations, &index);
   // New directions, candidates' observations and disagreements are registered against the
-  // directions the map already holds: only in a frame that two of them, well apart, located
-  // (or while the map has no two such), under a certain orientation. Else a drifted orientation
+  // directions the map already holds: only in a frame the map located (or while it holds no two
+  // confirmed directions well apart), under a certain orientation. Else a drifted orientation
   // would place copies of the map's directions a few degrees off, which would then hold the
-  // drift (one direction leaves the rotation about it free).
+  // drift.
   const bool certain = largest_sigma(P) <= options_.max_orientation_sigma_deg * kDeg &&
                        (location.paired > 0 || !pinnable());
   const double gate = chi2_quantile_99(2);

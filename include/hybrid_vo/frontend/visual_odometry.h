@@ -85,6 +85,8 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   visit_fields(o.estimator, prefixed("estimator_", visit));
   HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches);
   visit("rotation_drift_floor_deg", o.orientation.drift_floor_deg, non_negative());
+  visit("coast_blank_walls", o.orientation.coast_blank_walls);
+  visit("translation_given_rotation", o.orientation.translation_given_rotation);
   HYBRID_VO_FIELDS(positive(), o.mono_scale);
   visit("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines, non_negative());
   visit("stereo_offset_calibration", o.stereo_offset.enabled);
