@@ -362,6 +362,27 @@ TEST(DirectionMap, CapOnTheNumberOfDirections) {
   EXPECT_GE(map.stats().dropped, 4);
 }
 
+// Many VPs and many directions under a huge uncertainty: the search stops at its bound and pairs
+// nothing, instead of trying every assignment.
+TEST(DirectionAssociation, TheSearchIsBounded) {
+  std::vector<MapLandmark> landmarks;
+  std::vector<VpObservation> observations;
+  for (int k = 0; k < 24; ++k) {
+    const Eigen::Vector3d d =
+        rotation_about(Eigen::Vector3d(1, 2, 3).normalized(), 0.26 * k) * kX;
+    landmarks.push_back({d, std::pow(0.1 * kDeg, 2) * (Eigen::Matrix3d::Identity() - d * d.transpose())});
+    if (k < 8) observations.push_back({d, Eigen::Matrix3d::Zero()});
+  }
+  DirectionAssociationOptions options;
+  options.max_hypotheses = 200;
+  const DirectionAssociation a = associate_directions(Eigen::Matrix3d::Identity(),
+                                                      isotropic(60.0), observations, landmarks,
+                                                      options);
+  EXPECT_LE(a.hypotheses, 200);
+  EXPECT_EQ(a.paired, 0);
+  EXPECT_TRUE(a.ambiguous);
+}
+
 TEST(DirectionStructure, OrthogonalityIsTestedUnderTheCovariances) {
   StructureDirection a{0, kX, isotropic(0.1)}, b{1, rotation_about(kZ, 88.0 * kDeg) * kX,
                                                    isotropic(0.1)};

@@ -124,15 +124,16 @@ class Search {
          const std::vector<Eigen::Vector3d>& camera,
          const std::vector<Eigen::Matrix3d>& world_covariance,
          const std::vector<MapLandmark>& landmarks,
-         const std::vector<std::vector<int>>& candidates)
+         const std::vector<std::vector<int>>& candidates, int max_hypotheses)
       : R_(R), P_(P), camera_(camera), world_covariance_(world_covariance),
-        landmarks_(landmarks), candidates_(candidates), taken_(landmarks.size(), 0) {}
+        landmarks_(landmarks), candidates_(candidates), taken_(landmarks.size(), 0),
+        max_hypotheses_(max_hypotheses) {}
 
   void run(size_t i) {
-    if (i == candidates_.size()) return;
+    if (i == candidates_.size() || exhausted()) return;
     run(i + 1);  // i unpaired
     for (const int j : candidates_[i]) {
-      if (taken_[j]) continue;
+      if (taken_[j] || exhausted()) continue;
       pairs_.emplace_back(static_cast<int>(i), j);
       const Fit fit = fit_pairs(R_, P_, camera_, world_covariance_, landmarks_, pairs_);
       ++evaluated;
@@ -154,6 +155,8 @@ class Search {
     return n;
   }
 
+  bool exhausted() const { return evaluated >= max_hypotheses_; }
+
   struct Hypothesis {
     std::vector<std::pair<int, int>> pairs;
     Fit fit;
@@ -170,6 +173,7 @@ class Search {
   const std::vector<std::vector<int>>& candidates_;
   std::vector<char> taken_;
   std::vector<std::pair<int, int>> pairs_;
+  const int max_hypotheses_;
 };
 
 // Candidates of each observation: the landmarks whose linearised chi-square at the prediction is
@@ -294,9 +298,14 @@ DirectionAssociation associate_directions(const Eigen::Matrix3d& R, const Eigen:
   const std::vector<std::vector<int>> candidates =
       candidates_of(R, P, p.camera, p.world_covariance, landmarks, options);
   for (const std::vector<int>& c : candidates) out.candidates += !c.empty();
-  Search search(R, P, p.camera, p.world_covariance, landmarks, candidates);
+  Search search(R, P, p.camera, p.world_covariance, landmarks, candidates,
+                options.max_hypotheses);
   search.run(0);
   out.hypotheses = search.evaluated;
+  if (search.exhausted()) {
+    out.ambiguous = true;
+    return out;
+  }
   if (search.found.empty()) return out;
 
   // The most pairs, then the lowest joint chi-square.

@@ -43,11 +43,15 @@ struct DirectionAssociationOptions {
   // At most this many candidates per observation, nearest first, and observations considered.
   int max_candidates = 6;
   int max_observations = 8;
+  // Hypotheses evaluated at most; a search that needs more pairs nothing (counted as ambiguous):
+  // a frame's handful of VPs takes a few dozen.
+  int max_hypotheses = 5000;
 };
 
 template <typename Visit>
 void visit_fields(DirectionAssociationOptions& o, Visit&& visit) {
-  HYBRID_VO_FIELDS(positive(), o.candidate_chi2, o.max_candidates, o.max_observations);
+  HYBRID_VO_FIELDS(positive(), o.candidate_chi2, o.max_candidates, o.max_observations,
+                  o.max_hypotheses);
   HYBRID_VO_FIELDS(non_negative(), o.ambiguity_chi2, o.ambiguity_min_deg);
 }
 
