@@ -9,7 +9,7 @@ median time per call (the Python time includes the call, the argument checks, th
 reading R, t and the point inlier mask), and per call the C++ estimator's own time
 (timings['estimator_ms']) for a paired overhead that machine load hardly moves.
 
-Usage (after `source build/devel/setup.bash`):
+Usage (after `source devel/setup.bash`):
   python3 scripts/bench_estimator_python.py [--repeats 5] [--scenes 50] [--presets a,b]
 """
 import argparse
@@ -69,7 +69,7 @@ def run_cpp(args):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--bench", default=str(ROOT / "build/devel/lib/hybrid_vo/"
+    parser.add_argument("--bench", default=str(ROOT / "devel/lib/hybrid_vo/"
                                                "hybrid_vo_bench_estimator"))
     parser.add_argument("--scenes", type=int, default=50)
     parser.add_argument("--seed", type=int, default=7)

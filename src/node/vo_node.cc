@@ -162,6 +162,7 @@ void VoNode::process(const Frame& frame) {
   monitor_.accept(input.image.cols, input.image.rows);
   record_result(frame, result, lost);
   publish(frame, input, result, lost);
+  injected_leak_.on_frame();
   const double latency_ms = std::chrono::duration<double, std::milli>(
                                 std::chrono::steady_clock::now() - frame.received)
                                 .count();

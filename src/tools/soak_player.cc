@@ -5,7 +5,9 @@
 // frames' latency (publication to the node's ~relative_pose) into a CSV, and at the end prints
 //   summary: frames=... dropped=... rss_start_mb=... rss_end_mb=... rss_slope_mb_per_h=...
 //            latency_p50_ms=... latency_p99_ms=... (and the rate, CPU and counters)
-// scripts/soak drives it.
+// The RSS slope is fitted from steady_from_s: after the warm-up, once the node's bounded buffers
+// are full (--full-after answers), so that a buffer filling up to its bound is not read as a
+// leak. scripts/soak drives it.
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,6 +17,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -43,6 +46,7 @@ struct Options {
   int pid = 0;         // the node's process, sampled from /proc
   double sample_s = 10.0;
   double warmup_s = -1.0;  // < 0: 20 % of the run, at most 120 s
+  int full_after = 0;      // answers after which the node's bounded buffers are full
   double answer_timeout_s = 5.0;
 };
 
@@ -58,6 +62,8 @@ const char kUsage[] =
     "  --sample S      sampling period in seconds (default 10)\n"
     "  --warmup S      seconds left out of the RSS slope and the latency percentiles\n"
     "                  (default 20 % of the run, at most 120)\n"
+    "  --full-after N  answers after which the node's bounded buffers (its ~path) are full:\n"
+    "                  the RSS slope starts there when that is after the warm-up\n"
     "  --node NAME     the node's name (default hybrid_vo)\n";
 
 bool parse_args(int argc, char** argv, Options* o, std::string* error) {
@@ -93,6 +99,8 @@ bool parse_args(int argc, char** argv, Options* o, std::string* error) {
       o->sample_s = number;
     } else if (arg == "--warmup" && numeric && number >= 0) {
       o->warmup_s = number;
+    } else if (arg == "--full-after" && numeric && number >= 0) {
+      o->full_after = static_cast<int>(number);
     } else {
       *error = "bad argument '" + arg + " " + v + "'";
       return false;
@@ -340,6 +348,8 @@ class Player {
     if (sent == sent_at_.end()) return;
     const double ms = std::chrono::duration<double, std::milli>(now - sent->second).count();
     if (answers_.emplace(m->header.stamp, ms).second) {
+      if (full_at_s_ < 0 && static_cast<int>(answers_.size()) >= o_.full_after)
+        full_at_s_ = seconds_since_start(now);
       window_latencies_.push_back(ms);
       if (seconds_since_start(sent->second) >= warmup_s_) steady_latencies_.push_back(ms);
       ok_ += m->status == hybrid_vo::MotionEstimate::STATUS_OK;
@@ -358,9 +368,13 @@ class Player {
   }
 
   void print_summary() {
+    // Growth while a bounded buffer fills is no leak: the slope is fitted once every one is
+    // full (and the warm-up is over); never, when they never filled.
+    const double steady_from =
+        full_at_s_ < 0 ? std::numeric_limits<double>::infinity() : std::max(warmup_s_, full_at_s_);
     std::vector<double> t, rss;
     for (size_t i = 0; i < samples_t_.size(); ++i) {
-      if (samples_t_[i] < warmup_s_) continue;
+      if (samples_t_[i] < steady_from) continue;
       t.push_back(samples_t_[i] / 3600.0);
       rss.push_back(samples_rss_[i]);
     }
@@ -385,11 +399,12 @@ class Player {
     std::printf(
         "summary: frames=%d dropped=%d rss_start_mb=%.1f rss_end_mb=%.1f "
         "rss_slope_mb_per_h=%.2f latency_p50_ms=%.1f latency_p99_ms=%.1f rate_hz=%.2f "
-        "cpu_percent=%.1f ok=%d queue_drops=%d duration_s=%.0f warmup_s=%.0f load1=%.1f %s\n",
+        "cpu_percent=%.1f ok=%d queue_drops=%d duration_s=%.0f warmup_s=%.0f "
+        "steady_from_s=%.0f load1=%.1f %s\n",
         sent_, sent_ - answered, rss.empty() ? 0.0 : rss.front(), rss.empty() ? 0.0 : rss.back(),
         slope(t, rss), quantile(latencies, 0.5), p99,
         duration > 0 ? answered / duration : 0.0, cpu_mean, ok_, queue_drops_, duration, warmup_s_,
-        load_mean, rate_field.c_str());
+        std::isfinite(steady_from) ? steady_from : -1.0, load_mean, rate_field.c_str());
     std::fflush(stdout);
   }
 
@@ -397,6 +412,7 @@ class Player {
   std::vector<Frame> frames_;
   tf2_msgs::TFMessage statics_;
   double period_ = 0.1, warmup_s_ = 0.0;
+  double full_at_s_ = -1.0;  // when the node's bounded buffers were full (--full-after)
   ros::Time first_stamp_;
   ros::Publisher image_pub_, info_pub_, static_pub_;
   ros::Subscriber motion_sub_, diagnostics_sub_;

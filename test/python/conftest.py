@@ -2,6 +2,7 @@
 space, so that `import hybrid_vo` finds the built module)."""
 import os
 import pathlib
+import subprocess
 
 import pytest
 
@@ -19,3 +20,13 @@ def kitti():
     if not path.exists():
         pytest.skip(f"{path} not present")
     return path
+
+
+@pytest.fixture(scope="session")
+def rendered_bag(tmp_path_factory):
+    """A few small rendered stereo frames, for a running node to answer (node_runs.py)."""
+    bag = tmp_path_factory.mktemp("rendered") / "frames.bag"
+    subprocess.run([str(ROOT / "devel/lib/hybrid_vo/hybrid_vo_render_sequence"), "--out", str(bag),
+                    "--frames", "20", "--stereo", "--width", "320", "--height", "240",
+                    "--supersampling", "1"], check=True, capture_output=True, timeout=300)
+    return bag

@@ -34,6 +34,7 @@
 #include "hybrid_vo/frontend/fisheye_rectifier.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/node/frame_queue.h"
+#include "hybrid_vo/node/injected_leak.h"
 #include "hybrid_vo/node/latency_window.h"
 #include "hybrid_vo/node/node_parameters.h"
 #include "hybrid_vo/node/stream_monitor.h"
@@ -232,6 +233,8 @@ class VoNode {
   DirectionStructure map_structure_;
   DirectionMapStats map_stats_;
   int vp_priors_used_ = 0, vp_priors_rejected_ = 0, blank_wall_frames_ = 0, pairs_overruled_ = 0;
+
+  InjectedLeak injected_leak_;  // the soak's own test only (scripts/soak --leak)
 };
 
 }  // namespace hybrid_vo
