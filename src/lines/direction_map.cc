@@ -229,7 +229,8 @@ void DirectionMap::fuse(MapDirection* direction, const Eigen::Vector3d& world,
   direction->confirmed = direction->confirmed || direction->hits >= options_.confirm_hits;
 }
 
-void DirectionMap::add_direction(const Eigen::Vector3d& world, const Eigen::Matrix3d& covariance) {
+int DirectionMap::add_direction(const Eigen::Vector3d& world, const Eigen::Matrix3d& covariance) {
+  int evicted = -1;
   if (static_cast<int>(directions_.size()) >= options_.max_directions) {
     // Room from the least supported: a candidate before a confirmed direction, then the longest
     // unseen.
@@ -237,7 +238,9 @@ void DirectionMap::add_direction(const Eigen::Vector3d& world, const Eigen::Matr
       if (a.confirmed != b.confirmed) return !a.confirmed;
       return a.last_seen < b.last_seen;
     };
-    directions_.erase(std::min_element(directions_.begin(), directions_.end(), weaker));
+    const auto weakest = std::min_element(directions_.begin(), directions_.end(), weaker);
+    evicted = static_cast<int>(weakest - directions_.begin());
+    directions_.erase(weakest);
     ++stats_.dropped;
   }
   MapDirection d;
@@ -249,6 +252,7 @@ void DirectionMap::add_direction(const Eigen::Vector3d& world, const Eigen::Matr
   d.confirmed = d.hits >= options_.confirm_hits;
   directions_.push_back(d);
   ++stats_.created;
+  return evicted;
 }
 
 void DirectionMap::update(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
@@ -307,8 +311,9 @@ void DirectionMap::update(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
       nearest->last_chi2 = nearest_chi2;
       fuse(nearest, w, C);
     } else if (distinct) {
-      add_direction(w, C);
-      disagrees.resize(directions_.size(), 0);
+      const int evicted = add_direction(w, C);
+      if (evicted >= 0) disagrees.erase(disagrees.begin() + evicted);
+      disagrees.push_back(0);
     }
   }
   for (size_t j = 0; j < disagrees.size() && j < directions_.size(); ++j) {

@@ -61,6 +61,9 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
                                                 const Eigen::Matrix3d& P1,
                                                 const PairRotation& pair) const {
   OrientationEstimate e;
+  e.R_world_from_camera = R1;  // a non-finite input: nothing of the pair is taken
+  e.covariance = P1;
+  if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
   e.blank_wall = pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
   double extra = 0.0;
   if (e.blank_wall) {
@@ -76,43 +79,14 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   }
   predict(R1, P1, coast ? coasted : pair, extra, &e.R_world_from_camera, &e.covariance);
   if (coast) e.source = OrientationSource::kCoasted;
-  if (!all_finite(e.R_world_from_camera) || !all_finite(e.covariance)) return e;
+  if (!all_finite(e.R_world_from_camera) || !all_finite(e.covariance)) {
+    e.R_world_from_camera = R1;
+    e.covariance = P1;
+    return e;
+  }
   const Eigen::Matrix3d predicted = e.R_world_from_camera;
 
-  // The judge: the pair's VPs that the keyframe saw as directions of the map, with the same
-  // pairs, locate the current camera while hardly trusting the pair's rotation. Two of them,
-  // jointly consistent and away from the pair's rotation beyond both uncertainties, overrule it
-  // (a plane's points fit a wrong rotation; its VPs do not).
-  if (options_.correct && pair.vps.size() >= 2 && pair.keyframe_vps.size() == pair.vps.size()) {
-    const MapLocation before = map_.locate(R1, P1, pair.keyframe_vps);
-    // Only a pair whose pose refuses a VP that the keyframe saw as a direction of the map.
-    bool refused = false;
-    for (size_t k = 0; k < pair.vps.size() && k < pair.vp_accepted.size(); ++k)
-      refused = refused || (before.direction_id[k] >= 0 && !pair.vp_accepted[k]);
-    if (before.pinned && refused) {
-      Eigen::Matrix3d R_loose, P_loose;
-      predict(R1, P1, pair, std::max(extra, options_.judge_sigma_deg * kDeg), &R_loose, &P_loose);
-      const MapLocation judged =
-          map_.locate_known(R_loose, P_loose, pair.vps, before.direction_id);
-      if (judged.pinned) {
-        const Eigen::AngleAxisd apart(judged.R_world_from_camera * predicted.transpose());
-        const Eigen::Vector3d delta = apart.angle() * apart.axis();
-        const Eigen::FullPivLU<Eigen::Matrix3d> lu(e.covariance + judged.covariance);
-        TranslationEstimate refit;
-        if (lu.isInvertible() && delta.dot(lu.inverse() * delta) > options_.reject_chi2 &&
-            refit_translation(R1, judged.R_world_from_camera, pair, &refit)) {
-          e.source = OrientationSource::kPairRejected;
-          e.refit = refit;
-          e.R_world_from_camera = judged.R_world_from_camera;
-          e.covariance = judged.covariance;
-          e.location = judged;
-          e.observations = pair.vps;
-          e.correction_deg = angle_deg(e.R_world_from_camera, predicted);
-          return e;
-        }
-      }
-    }
-  }
+  if (options_.correct && judge(R1, P1, pair, extra, &e)) return e;
 
   for (size_t k = 0; k < pair.vps.size(); ++k)
     if (k >= pair.vp_accepted.size() || pair.vp_accepted[k])
@@ -127,6 +101,41 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
       !refit_translation(R1, e.R_world_from_camera, pair, &e.refit))
     e.refit = TranslationEstimate();
   return e;
+}
+
+bool OrientationFilter::judge(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
+                              const PairRotation& pair, double extra_sigma_rad,
+                              OrientationEstimate* e) const {
+  if (pair.vps.size() < 2 || pair.keyframe_vps.size() != pair.vps.size()) return false;
+  // Only a pair whose pose refuses a VP that the keyframe saw as a direction of the map.
+  const MapLocation before = map_.locate(R1, P1, pair.keyframe_vps);
+  bool refused = false;
+  for (size_t k = 0; k < pair.vps.size() && k < pair.vp_accepted.size(); ++k)
+    refused = refused || (before.direction_id[k] >= 0 && !pair.vp_accepted[k]);
+  if (!before.pinned || !refused) return false;
+  // Those VPs, with the keyframe's pairs, locate the current camera while hardly trusting the
+  // pair's rotation.
+  Eigen::Matrix3d R_loose, P_loose;
+  predict(R1, P1, pair, std::max(extra_sigma_rad, options_.judge_sigma_deg * kDeg), &R_loose,
+          &P_loose);
+  const MapLocation judged = map_.locate_known(R_loose, P_loose, pair.vps, before.direction_id);
+  if (!judged.pinned) return false;
+  const Eigen::Matrix3d predicted = e->R_world_from_camera;
+  const Eigen::AngleAxisd apart(judged.R_world_from_camera * predicted.transpose());
+  const Eigen::Vector3d delta = apart.angle() * apart.axis();
+  const Eigen::FullPivLU<Eigen::Matrix3d> lu(e->covariance + judged.covariance);
+  if (!lu.isInvertible() || !(delta.dot(lu.inverse() * delta) > options_.reject_chi2))
+    return false;
+  TranslationEstimate refit;
+  if (!refit_translation(R1, judged.R_world_from_camera, pair, &refit)) return false;
+  e->source = OrientationSource::kPairRejected;
+  e->refit = refit;
+  e->R_world_from_camera = judged.R_world_from_camera;
+  e->covariance = judged.covariance;
+  e->location = judged;
+  e->observations = pair.vps;
+  e->correction_deg = angle_deg(e->R_world_from_camera, predicted);
+  return true;
 }
 
 bool OrientationFilter::refit_translation(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& R2,

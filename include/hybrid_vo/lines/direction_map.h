@@ -165,7 +165,8 @@ class DirectionMap {
   MapLocation locate_with(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                           const std::vector<VpObservation>& observations,
                           const std::vector<int>* known_ids) const;
-  void add_direction(const Eigen::Vector3d& world, const Eigen::Matrix3d& covariance);
+  // Returns the index of the direction that made room for it, or -1.
+  int add_direction(const Eigen::Vector3d& world, const Eigen::Matrix3d& covariance);
   void fuse(MapDirection* direction, const Eigen::Vector3d& world,
             const Eigen::Matrix3d& covariance);
 

@@ -110,7 +110,7 @@ class OrientationFilter {
   explicit OrientationFilter(const OrientationFilterOptions& options = {});
 
   // The current camera's orientation given the keyframe's (R1, covariance P1) and the pair.
-  // Invalid input leaves the prediction as it is.
+  // A non-finite pair rotation or covariance leaves the keyframe's.
   OrientationEstimate estimate(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
                                const PairRotation& pair) const;
   // The pair's prediction alone, without the map: its rotation and its covariance grown by it.
@@ -135,6 +135,12 @@ class OrientationFilter {
   void predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1, const PairRotation& pair,
                double extra_sigma_rad, Eigen::Matrix3d* R, Eigen::Matrix3d* P) const;
 
+  // The map's judgement of the pair (e holds its prediction): whether the pair's VPs that the
+  // keyframe saw as two directions of the map, well apart, locate the current camera away from
+  // the pair's rotation beyond both covariances, with the pair's points supporting the map's
+  // rotation (a plane's points fit a wrong rotation; its VPs do not). Then e is the map's.
+  bool judge(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1, const PairRotation& pair,
+             double extra_sigma_rad, OrientationEstimate* e) const;
   // The pair's translation fitted under the rotation R2 of the current camera (R1: keyframe's);
   // whether its points support it (reject_min_inlier_share).
   bool refit_translation(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& R2,
