@@ -17,10 +17,6 @@ VisualOdometryOptions::VisualOdometryOptions() {
   estimator.vp_detection.min_long_inliers = 3;
   estimator.vp_detection.min_support_px = 150.0;
   estimator.junctions.length_fraction = 0.15;
-  // A scene direction does not go away: a track survives a few seconds unseen, and is not dropped
-  // for disagreeing with the odometry, which is what it exists to correct (anchor_orientation).
-  vp_tracker.max_misses = 60;
-  vp_tracker.max_gate_failures = 0;
 }
 
 const char* to_string(VoStatus status) {
@@ -137,16 +133,20 @@ bool VisualOdometry::begin_frame(Frame& f) {
 }
 
 void VisualOdometry::orient(Frame& f) {
-  f.oriented = orientation_.orient(keyframe_.R_wc, keyframe_.R_wc_covariance,
-                                   f.result.estimate.estimate, f.result.matches,
-                                   f.input.camera.pinhole.K());
-  f.result.anchoring = f.oriented.anchoring;
+  VoOrientation::Pair pair;
+  pair.estimate = &f.result.estimate.estimate;
+  pair.matches = &f.result.matches;
+  pair.keyframe_camera = keyframe_.camera.pinhole;
+  pair.camera = f.input.camera.pinhole;
+  pair.dt = f.input.stamp - keyframe_.stamp;
+  pair.vps_detected = f.vps_detected;
+  f.oriented = orientation_.orient(keyframe_.R_wc, keyframe_.R_wc_covariance, pair);
+  f.result.orientation = f.oriented.estimate;
 }
 
 void VisualOdometry::integrate(Frame& f) {
   VisualOdometryResult& r = f.result;
-  r.vp_associations = orientation_.advance(f.oriented, r.estimate.estimate.pose.R,
-                                           f.input.stamp - keyframe_.stamp);
+  orientation_.advance(f.oriented, f.input.stamp - keyframe_.stamp);
   // The current camera's centre in the keyframe is -R^T t.
   centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
   r.R_wc = orientation_.R_wc();

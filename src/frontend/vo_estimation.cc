@@ -1,5 +1,5 @@
 // VisualOdometry's estimation of a pair: its matches undistorted, VPs detected jointly from the
-// segments and given the tracks' priors (VoOrientation), then the hybrid estimator.
+// segments and given the map's priors (VoOrientation), then the hybrid estimator.
 #include <chrono>
 #include <string>
 
@@ -48,8 +48,10 @@ bool VisualOdometry::estimate(Frame& f) {
                                                                   vp_options);
     m.vps = vps.matches;
     m.line_vp = vps.labels;
-    r.vp_track_ids = orientation_.add_vp_priors(keyframe_.R_wc, keyframe_.camera.pinhole.K(), &m);
+    r.vp_track_ids = orientation_.add_vp_priors(keyframe_.R_wc, keyframe_.R_wc_covariance,
+                                                keyframe_.camera.pinhole.K(), &m);
   }
+  f.vps_detected = uses_vps(estimator);
   times.vps_ms = ms_since(vps_start);
   estimator.detect_vps = false;  // detected above (or unwanted)
   const auto ransac_start = std::chrono::steady_clock::now();

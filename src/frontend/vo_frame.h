@@ -49,7 +49,8 @@ struct VisualOdometry::Frame {
   std::vector<StereoScaleObservation> scale_observations;
   std::vector<int64_t> observed;  // the ids of the scale's observations
 
-  // The pair's orientation (orient).
+  // The pair's orientation (orient): whether the estimator looked for VPs, and the outcome.
+  bool vps_detected = false;
   VoOrientation::Oriented oriented;
 
   // The KLT re-detection for the next frame.

@@ -1,5 +1,6 @@
-// The visual odometry's orientation: pair rotations chained, anchored by the VP tracks; the VP
-// tracker's priors and updates; the rotation rate that predicts the segments' motion.
+// The visual odometry's orientation: pair rotations chained, held by the map of world directions
+// (OrientationFilter); the map's priors and seeds; the rotation rate that predicts the segments'
+// motion.
 #include "hybrid_vo/frontend/vo_orientation.h"
 
 #include <cmath>
@@ -13,10 +14,10 @@
 namespace hybrid_vo {
 namespace {
 
-// The VPs of one image of a pair as tracker observations: each direction with the covariance of
-// its fit to that image's labelled segments (pixels, at `sigma_px` per segment) plus `vp_sigma_deg`
-// per axis, the pair's measured VP scale: the fit alone is optimistic (rendered corridor: the fit
-// says 0.02-0.1 degrees, the VPs are 0.05-0.3 degrees off the true axes).
+// The VPs of one image of a pair as the map's observations: each direction with the covariance
+// of its fit to that image's labelled segments (pixels, at `sigma_px` per segment) plus
+// `vp_sigma_deg` per axis, the pair's measured VP scale: the fit alone is optimistic (rendered
+// corridor: the fit says 0.02-0.1 degrees, the VPs are 0.05-0.3 degrees off the true axes).
 std::vector<VpObservation> vp_observations(const Eigen::Matrix3d& K, const TwoViewMatches& m,
                                            bool second_image, double sigma_px,
                                            double vp_sigma_deg) {
@@ -27,7 +28,7 @@ std::vector<VpObservation> vp_observations(const Eigen::Matrix3d& K, const TwoVi
   std::vector<VpObservation> observations(m.vps.size());
   for (size_t k = 0; k < m.vps.size(); ++k) {
     observations[k].direction = second_image ? m.vps[k].d2 : m.vps[k].d1;
-    // Without a usable fit the covariance stays zero: the tracker's default sigma.
+    // Without a usable fit the covariance stays zero: the map's default sigma.
     Eigen::Matrix3d covariance;
     if (vp_measurement_covariance(K, segments[k], observations[k].direction, sigma_px,
                                   vp_sigma_deg * M_PI / 180.0, &covariance))
@@ -36,37 +37,23 @@ std::vector<VpObservation> vp_observations(const Eigen::Matrix3d& K, const TwoVi
   return observations;
 }
 
-// The VPs that the pose `est` accepts, as seen in the current image, each with the covariance
-// of its fit to that image's segments at the pair's measured segment noise.
-std::vector<VpObservation> inlier_vp_observations(const Eigen::Matrix3d& K,
-                                                  const TwoViewMatches& m,
-                                                  const RelativePoseEstimate& est) {
-  TwoViewMatches inliers;
-  inliers.lines = m.lines;
-  inliers.line_vp = m.line_vp;
-  std::vector<int> kept(m.vps.size(), -1);
-  for (size_t k = 0; k < m.vps.size(); ++k) {
-    if (k < est.vp_inliers.size() && !est.vp_inliers[k]) continue;
-    kept[k] = static_cast<int>(inliers.vps.size());
-    inliers.vps.push_back(m.vps[k]);
-  }
-  for (int& label : inliers.line_vp) label = label >= 0 ? kept[label] : -1;
-  return vp_observations(K, inliers, true, est.scales.line_vp_px, est.scales.vp_deg);
+OrientationFilterOptions filter_options(const VisualOdometryOptions& options) {
+  OrientationFilterOptions o = options.orientation;
+  o.correct = options.anchor_orientation;
+  return o;
 }
 
 }  // namespace
 
 VoOrientation::VoOrientation(const VisualOdometryOptions& options)
-    : use_tracker_(options.use_vp_tracker),
-      anchor_(options.use_vp_tracker && options.anchor_orientation),
-      drift_floor_deg_(options.rotation_drift_floor_deg),
+    : use_map_(options.use_vp_tracker),
       seed_sigma_px_(options.estimator.vp_detection.inlier_threshold_px / 3.0),
       seed_sigma_deg_(options.estimator.ransac.vp_threshold_deg / 3.0),
-      tracker_(options.vp_tracker) {}
+      filter_(filter_options(options)) {}
 
 void VoOrientation::restart() {
   angular_velocity_.setZero();
-  tracker_.reset();
+  filter_.reset();
   seeded_ = false;
 }
 
@@ -84,59 +71,80 @@ Eigen::Matrix3d VoOrientation::segment_motion(const PinholeCamera& camera, doubl
 }
 
 std::vector<int> VoOrientation::add_vp_priors(const Eigen::Matrix3d& keyframe_R_wc,
+                                              const Eigen::Matrix3d& keyframe_covariance,
                                               const Eigen::Matrix3d& keyframe_K,
                                               TwoViewMatches* m) {
-  std::vector<int> track_ids;
-  if (!use_tracker_) return track_ids;
+  std::vector<int> direction_ids;
+  if (!use_map_) return direction_ids;
   if (!seeded_) {
-    tracker_.update(keyframe_R_wc,
-                    vp_observations(keyframe_K, *m, false, seed_sigma_px_, seed_sigma_deg_));
+    filter_.seed(keyframe_R_wc, keyframe_covariance,
+                 vp_observations(keyframe_K, *m, false, seed_sigma_px_, seed_sigma_deg_));
     seeded_ = true;
   }
-  m->vp_priors = tracker_.priors(keyframe_R_wc, m->vps);
-  for (const VpPrior& prior : m->vp_priors) track_ids.push_back(prior.track_id);
-  return track_ids;
+  m->vp_priors = filter_.priors(keyframe_R_wc, keyframe_covariance, m->vps);
+  for (const VpPrior& prior : m->vp_priors) direction_ids.push_back(prior.track_id);
+  return direction_ids;
 }
 
 VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_wc,
                                               const Eigen::Matrix3d& keyframe_covariance,
-                                              const RelativePoseEstimate& est,
-                                              const TwoViewMatches& m,
-                                              const Eigen::Matrix3d& K) const {
+                                              const Pair& pair) const {
+  const RelativePoseEstimate& est = *pair.estimate;
+  const TwoViewMatches& m = *pair.matches;
+  PairRotation rotation;
+  rotation.R = est.pose.R;
+  if (est.covariance_valid) rotation.covariance = est.covariance.topLeftCorner<3, 3>();
+  rotation.segment_matches = static_cast<int>(m.lines.size());
+  rotation.vp_inliers = est.num_vp_inliers;
+  if (pair.dt > 0.0) {
+    const Eigen::Vector3d w = angular_velocity_ * pair.dt;
+    rotation.has_last_motion = true;
+    rotation.last_motion_R = w.norm() > 0.0 ? rotation_about(w.normalized(), w.norm())
+                                            : Eigen::Matrix3d::Identity();
+  }
   Oriented o;
-  o.pose = est.pose;
-  if (use_tracker_) o.seen = inlier_vp_observations(K, m, est);
-  o.R_wc = nearest_rotation(keyframe_R_wc * o.pose.R.transpose());
-  // The pair's rotation error as a left increment of R (camera 2) is -R_wc times it in the
-  // odometry frame.
-  const double floor = drift_floor_deg_ * M_PI / 180.0;
-  o.covariance = keyframe_covariance + floor * floor * Eigen::Matrix3d::Identity();
-  if (est.covariance_valid)
-    o.covariance += o.R_wc * est.covariance.topLeftCorner<3, 3>() * o.R_wc.transpose();
-  if (!anchor_) return o;
-  o.anchoring = tracker_.anchor(o.R_wc, o.covariance, o.seen);
-  o.covariance = o.anchoring.covariance;
-  // The correction is the drift of earlier pairs, not this pair's motion: the translation stays
-  // as this pair's points fixed it (re-fitted under the anchored rotation, it was 37 -> 51 deg
-  // off on TUM fr3 structure_notexture).
-  if (o.anchoring.anchors > 0) {
-    o.R_wc = o.anchoring.R_world_from_camera;
+  o.pose = o.scale_pose = est.pose;
+  if (!use_map_ || !pair.vps_detected) {
+    o.estimate = filter_.predict(keyframe_R_wc, keyframe_covariance, rotation);
+  } else {
+    // Each VP with the covariance of its fit to the segments at the pair's measured noise.
+    rotation.vps = vp_observations(pair.camera.K(), m, true, est.scales.line_vp_px,
+                                   est.scales.vp_deg);
+    rotation.vp_accepted = est.vp_inliers;
+    rotation.keyframe_vps = vp_observations(pair.keyframe_camera.K(), m, false,
+                                            est.scales.line_vp_px, est.scales.vp_deg);
+    rotation.points = &m.points;
+    rotation.camera1 = pair.keyframe_camera;
+    rotation.camera2 = pair.camera;
+    rotation.point_inliers = est.num_point_inliers;
+    o.estimate = filter_.estimate(keyframe_R_wc, keyframe_covariance, rotation);
+  }
+  o.R_wc = o.estimate.R_world_from_camera;
+  o.covariance = o.estimate.covariance;
+  // A correction is the drift of earlier pairs, not this pair's motion: the translation stays as
+  // this pair's points fixed it (re-fitted under the anchored rotation, it was 37 -> 51 deg off
+  // on TUM fr3 structure_notexture). A rejected pair's rotation was wrong: its translation was
+  // fitted again under the map's, and that pose also scales the motion.
+  if (o.estimate.source != OrientationSource::kPair)
     o.pose.R = nearest_rotation(o.R_wc.transpose() * keyframe_R_wc);
+  if (o.estimate.source == OrientationSource::kPairRejected) {
+    o.pose.t = o.estimate.refit.pose.t;
+    o.scale_pose = o.pose;
+  } else if (o.estimate.refit.ok) {
+    o.pose.t = o.estimate.refit.pose.t;  // translation_given_rotation
   }
   return o;
 }
 
-std::vector<VpAssociation> VoOrientation::advance(const Oriented& oriented,
-                                                  const Eigen::Matrix3d& pair_R, double dt) {
-  if (dt > 0.0) {
-    const Eigen::AngleAxisd turned(pair_R);
+void VoOrientation::advance(const Oriented& oriented, double dt) {
+  // A coasted pair keeps the last rate: its own rotation is what could not be trusted.
+  if (dt > 0.0 && oriented.estimate.source != OrientationSource::kCoasted) {
+    const Eigen::AngleAxisd turned(oriented.scale_pose.R);
     angular_velocity_ = turned.angle() * turned.axis() / dt;
   }
   R_wc_ = oriented.R_wc;
   covariance_ = oriented.covariance;
-  // Every estimated frame, also without VPs, so that misses count.
-  if (!use_tracker_) return {};
-  return tracker_.update(R_wc_, oriented.seen);
+  if (use_map_) filter_.update(oriented.estimate);
 }
 
 }  // namespace hybrid_vo

@@ -197,11 +197,12 @@ void VisualOdometry::fit_scale(Frame& f) {
     const StereoRig rig{f.input.camera.pinhole.fx, f.input.camera.pinhole.fy, f.input.baseline_m};
     // The pair's own pose: its rotation and translation explain its points together, and the
     // scale is fitted to those points (with the anchored rotation the demo's ATE was 0.0135 m
-    // against 0.0115).
-    offset_filter_.update(est.pose, rig, r.scale_observations, options_.stereo_scale);
+    // against 0.0115); a pose the map overruled is replaced by the one fitted under the map's.
+    const RelativePose& scale_pose = f.oriented.scale_pose;
+    offset_filter_.update(scale_pose, rig, r.scale_observations, options_.stereo_scale);
     StereoScaleOptions scale_options = options_.stereo_scale;
     scale_options.disparity_offset_px = r.disparity_offset_px = offset_filter_.offset();
-    r.stereo_scale = estimate_stereo_scale(est.pose, rig, r.scale_observations, scale_options);
+    r.stereo_scale = estimate_stereo_scale(scale_pose, rig, r.scale_observations, scale_options);
     if (r.stereo_scale.status == StereoScaleStatus::kOk) {
       scale = r.stereo_scale.scale;
       scale_sigma = r.stereo_scale.sigma;

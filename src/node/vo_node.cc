@@ -258,13 +258,18 @@ void VoNode::record_result(const Frame& frame, const VisualOdometryResult& resul
   }
   {
     std::lock_guard<std::mutex> lock(stats_mutex_);
-    vp_tracks_ = vo_->vp_tracker().tracks();
+    map_directions_ = vo_->direction_map().directions();
+    map_structure_ = vo_->direction_map().structure();
+    map_stats_ = vo_->direction_map().stats();
     const RelativePoseEstimate& est = result.estimate.estimate;
     for (size_t k = 0; k < est.vp_prior_chi2.size() && k < est.vp_prior_used.size(); ++k) {
       if (est.vp_prior_used[k]) ++vp_priors_used_;
       else if (std::isfinite(est.vp_prior_chi2[k])) ++vp_priors_rejected_;
     }
-    for (const VpAssociation& a : result.vp_associations) vp_track_gate_failures_ += a.gated_out;
+    if (result.status == VoStatus::kOk) {
+      blank_wall_frames_ += result.orientation.blank_wall;
+      pairs_overruled_ += result.orientation.source == OrientationSource::kPairRejected;
+    }
   }
   if (result.stereo_scale_attempted && !result.scale_known) {
     std::lock_guard<std::mutex> lock(stats_mutex_);

@@ -98,11 +98,12 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("line inliers", est.num_line_inliers);
   status.add("VP inliers", est.num_vp_inliers);
   status.add("junction inliers", est.num_junction_inliers);
-  // Orientation anchoring: how many VP tracks corrected this frame's orientation, by how much,
-  // and how many disagreed beyond the gate.
-  status.add("orientation anchors", r.anchoring.anchors);
-  status.add("orientation anchors rejected", r.anchoring.rejected);
-  status.add("orientation correction (deg)", r.anchoring.correction_deg);
+  // This frame against the map of world directions: where its orientation came from, how many
+  // directions it saw, by how much they corrected it, and whether the pair was a blank wall.
+  status.add("orientation source", to_string(r.orientation.source));
+  status.add("orientation: map directions seen", r.orientation.location.paired);
+  status.add("orientation correction (deg)", r.orientation.correction_deg);
+  status.add("blank wall", r.orientation.blank_wall);
   status.add("scale known", r.scale_known);
   if (r.stereo_scale_attempted) {
     status.add("stereo scale", to_string(r.stereo_scale.status));
@@ -129,25 +130,31 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
 }
 
 void VoNode::add_vp_tracks(diagnostic_updater::DiagnosticStatusWrapper& status) const {
-  // The VP tracker: each track's uncertainty and gate, and how its priors fared in the estimator.
-  int confident = 0;
-  for (const VpTrack& track : vp_tracks_) {
-    confident += track.confident;
+  // The map of world directions: each direction's uncertainty and support, its structure, how
+  // often it held the orientation, and how its priors fared in the estimator.
+  int confirmed = 0;
+  for (const MapDirection& d : map_directions_) {
+    confirmed += d.confirmed;
     char key[64], value[160];
-    std::snprintf(key, sizeof(key), "VP track %d", track.id);
+    std::snprintf(key, sizeof(key), "map direction %d", d.id);
     std::snprintf(value, sizeof(value),
-                  "sigma %.3f deg, hits %d, last chi2 %.2f (%s), gate failures %d in a row, %d "
-                  "in total%s",
-                  track.sigma_deg(), track.hits, track.last_chi2,
-                  track.last_gate_passed ? "passed" : "failed", track.gate_failures,
-                  track.total_gate_failures, track.confident ? "" : ", not yet confident");
+                  "sigma %.3f deg, hits %d, last chi2 %.2f, disagreements %d in a row, %d in "
+                  "total%s",
+                  d.sigma_deg(), d.hits, d.last_chi2, d.disagreements, d.total_disagreements,
+                  d.confirmed ? "" : ", not yet confirmed");
     status.add(key, value);
   }
-  status.add("VP tracks", static_cast<int>(vp_tracks_.size()));
-  status.add("VP tracks confident", confident);
+  status.add("map directions", static_cast<int>(map_directions_.size()));
+  status.add("map directions confirmed", confirmed);
+  status.add("map Manhattan triads", static_cast<int>(map_structure_.triads.size()));
+  status.add("map Atlanta verticals", static_cast<int>(map_structure_.verticals.size()));
+  status.add("frames held by the map", map_stats_.located);
+  status.add("map re-acquisitions", map_stats_.reacquisitions);
+  status.add("map corrections rejected", map_stats_.rejected);
+  status.add("pairs overruled by the map", pairs_overruled_);
+  status.add("blank-wall frames", blank_wall_frames_);
   status.add("VP priors used", vp_priors_used_);
   status.add("VP priors rejected by the gate", vp_priors_rejected_);
-  status.add("VP detections failing their track's gate", vp_track_gate_failures_);
 }
 
 void VoNode::add_counters(diagnostic_updater::DiagnosticStatusWrapper& status) const {

@@ -1,5 +1,7 @@
 // The node's outputs of the motion: ~relative_pose, tf, ~odometry, ~path and ~vanishing_points
 // (DESIGN.md, "The node"; as viso2_ros's odometer base class publishes tf and odometry).
+#include <algorithm>
+
 #include <Eigen/Geometry>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -37,7 +39,8 @@ uint8_t status_code(const VisualOdometryResult& r) {
 }
 
 // Matches, inliers, solver statistics and timings of a frame, into its message.
-void fill_statistics(const VisualOdometryResult& result, bool moved, MotionEstimate* rel) {
+void fill_statistics(const VisualOdometryResult& result, bool moved, int map_directions,
+                     MotionEstimate* rel) {
   const RelativePoseEstimate& est = result.estimate.estimate;
   rel->points = result.num_point_matches;
   rel->lines = result.num_line_matches;
@@ -47,6 +50,29 @@ void fill_statistics(const VisualOdometryResult& result, bool moved, MotionEstim
   rel->junction_inliers = est.num_junction_inliers;
   rel->vps = result.matches.vps.size();
   rel->vp_inliers = est.num_vp_inliers;
+  const OrientationEstimate& o = result.orientation;
+  switch (o.source) {
+    case OrientationSource::kPair:
+      rel->orientation_source = MotionEstimate::ORIENTATION_PAIR;
+      break;
+    case OrientationSource::kMap:
+      rel->orientation_source = MotionEstimate::ORIENTATION_MAP;
+      break;
+    case OrientationSource::kReacquired:
+      rel->orientation_source = MotionEstimate::ORIENTATION_REACQUIRED;
+      break;
+    case OrientationSource::kCoasted:
+      rel->orientation_source = MotionEstimate::ORIENTATION_COASTED;
+      break;
+    case OrientationSource::kPairRejected:
+      rel->orientation_source = MotionEstimate::ORIENTATION_PAIR_REJECTED;
+      break;
+  }
+  rel->map_directions_seen = o.location.paired;
+  rel->map_directions = map_directions;
+  rel->orientation_correction_deg = o.correction_deg;
+  rel->blank_wall = o.blank_wall;
+  rel->map_correction_rejected = o.location.ambiguous || o.location.rejected;
   for (const SolverInfo& info : solver_table()) {
     const SolverStatistics& s = est.solvers[static_cast<int>(info.id)];
     if (s.sampled == 0) continue;
@@ -104,7 +130,9 @@ void VoNode::publish_relative_pose(const Frame& frame, const VisualOdometryResul
     // uncertainty along t.
     for (int i = 0; i < 36; ++i) rel.covariance[i] = result.motion_covariance(i / 6, i % 6);
   }
-  fill_statistics(result, moved, &rel);
+  int confirmed = 0;
+  for (const MapDirection& d : vo_->direction_map().directions()) confirmed += d.confirmed;
+  fill_statistics(result, moved, confirmed, &rel);
   relative_pose_pub_.publish(rel);
 }
 
@@ -192,23 +220,27 @@ Eigen::Matrix3d VoNode::R_odom_world() const {
 }
 
 void VoNode::publish_vanishing_points(const ros::Time& stamp, const VisualOdometryResult& result) {
-  // Tracked VPs, in the odometry frame (the first camera's frame turned into odom_frame).
+  // The map's directions, in the odometry frame (the first camera's frame turned into
+  // odom_frame), each with its map id and whether this frame's VPs saw it.
   VanishingPoints vps;
   vps.header.stamp = stamp;
   vps.header.frame_id = params_.odom_frame;
-  for (const VpTrack& track : vo_->vp_tracker().tracks()) {
+  const DirectionMap& map = vo_->direction_map();
+  const std::vector<int>& seen = result.orientation.location.direction_id;
+  for (const MapDirection& d : map.directions()) {
     VanishingPoint vp;
-    vp.id = track.id;
-    vp.direction_odom = to_vector(R_odom_world() * track.direction);
-    vp.direction_camera = to_vector(result.R_wc.transpose() * track.direction);
-    vp.hits = track.hits;
-    vp.age = track.age;
-    vp.confident = track.confident;
-    vp.sigma_deg = track.sigma_deg();
-    vp.last_chi2 = track.last_chi2;
-    vp.last_gate_passed = track.last_gate_passed;
-    vp.gate_failures = track.gate_failures;
-    vp.total_gate_failures = track.total_gate_failures;
+    vp.id = d.id;
+    vp.direction_odom = to_vector(R_odom_world() * d.direction);
+    vp.direction_camera = to_vector(result.R_wc.transpose() * d.direction);
+    vp.hits = d.hits;
+    vp.age = map.frames() - d.created;
+    vp.confident = d.confirmed;
+    vp.seen = std::find(seen.begin(), seen.end(), d.id) != seen.end();
+    vp.sigma_deg = d.sigma_deg();
+    vp.last_chi2 = d.last_chi2;
+    vp.last_gate_passed = d.disagreements == 0;
+    vp.gate_failures = d.disagreements;
+    vp.total_gate_failures = d.total_disagreements;
     vps.vps.push_back(vp);
   }
   vps_pub_.publish(vps);

@@ -1,5 +1,6 @@
 // What the node draws for rviz, only while someone subscribes: tracked VP directions and inlier
 // segments in 3D as ~markers, and inlier points and segments coloured by VP as ~debug_image.
+#include <algorithm>
 #include <cmath>
 
 #include <cv_bridge/cv_bridge.h>
@@ -12,28 +13,30 @@
 namespace hybrid_vo {
 namespace {
 
-// Confident VP tracks as arrows from the camera centre (odom frame), in their debug image colour.
-void add_vp_arrows(const std::vector<VpTrack>& tracks, const Eigen::Matrix3d& R_odom_world,
-                   const Eigen::Vector3d& centre, const std_msgs::Header& header,
-                   visualization_msgs::MarkerArray* markers) {
-  for (const VpTrack& track : tracks) {
-    if (!track.confident) continue;
-    visualization_msgs::Marker arrow;
-    arrow.header = header;
-    arrow.ns = "vanishing_points";
-    arrow.id = track.id;
-    arrow.type = visualization_msgs::Marker::ARROW;
-    arrow.scale.x = 0.05;
-    arrow.scale.y = 0.1;
-    arrow.scale.z = 0.1;
-    const cv::Scalar c = vp_colour(track.id);
-    arrow.color.b = c[0] / 255.0;
-    arrow.color.g = c[1] / 255.0;
-    arrow.color.r = c[2] / 255.0;
-    arrow.color.a = 1.0;
-    arrow.pose.orientation.w = 1.0;
-    arrow.points = {to_point(centre), to_point(centre + R_odom_world * track.direction)};
-    markers->markers.push_back(arrow);
+// The map's confirmed directions as world-fixed axes through the camera centre (odom frame):
+// each a line both ways (a direction has no sign), in its debug image colour, thicker while the
+// current frame sees it.
+void add_map_axes(const DirectionMap& map, const std::vector<int>& seen,
+                  const Eigen::Matrix3d& R_odom_world, const Eigen::Vector3d& centre,
+                  const std_msgs::Header& header, visualization_msgs::MarkerArray* markers) {
+  for (const MapDirection& d : map.directions()) {
+    if (!d.confirmed) continue;
+    visualization_msgs::Marker axis;
+    axis.header = header;
+    axis.ns = "vanishing_points";
+    axis.id = d.id;
+    axis.type = visualization_msgs::Marker::LINE_LIST;
+    const bool visible = std::find(seen.begin(), seen.end(), d.id) != seen.end();
+    axis.scale.x = visible ? 0.04 : 0.015;
+    const cv::Scalar c = vp_colour(d.id);
+    axis.color.b = c[0] / 255.0;
+    axis.color.g = c[1] / 255.0;
+    axis.color.r = c[2] / 255.0;
+    axis.color.a = 1.0;
+    axis.pose.orientation.w = 1.0;
+    const Eigen::Vector3d u = R_odom_world * d.direction;
+    axis.points = {to_point(centre - u), to_point(centre + u)};
+    markers->markers.push_back(axis);
   }
 }
 
@@ -49,8 +52,8 @@ void VoNode::publish_markers(const ros::Time& stamp, const VisualOdometryInput& 
   clear.action = visualization_msgs::Marker::DELETEALL;
   markers.markers.push_back(clear);
   const Eigen::Vector3d offset = have_base_transform_ ? t_base_camera_ : Eigen::Vector3d::Zero();
-  add_vp_arrows(vo_->vp_tracker().tracks(), R_odom_world(),
-                R_odom_world() * result.centre + offset, header, &markers);
+  add_map_axes(vo_->direction_map(), result.orientation.location.direction_id, R_odom_world(),
+               R_odom_world() * result.centre + offset, header, &markers);
   // Inlier segments in 3D need the depth, so a metric motion.
   if (result.status == VoStatus::kOk && result.scale_known) {
     visualization_msgs::Marker lines = inlier_segments(input, result);

@@ -47,7 +47,7 @@ void usage(const char* program) {
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
                "  the KLT corners' strength floor (0: every corner); --drop-leaving: KLT drops\n"
                "  the features predicted outside the image unsearched; --no-anchor: no orientation\n"
-               "  anchoring by the VP tracks. Default preset hybrid+junc.\n"
+               "  correction by the map of directions. Default preset hybrid+junc.\n"
                "  --opencv-threads N: OpenCV's own thread pool (cv::setNumThreads), as the node's\n"
                "  opencv_threads parameter; default 1 (none: the front end splits its work over\n"
                "  its two threads itself); -1 leaves OpenCV's default.\n"
@@ -163,6 +163,12 @@ int run(int argc, char** argv) {
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
     else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
     else if (a == "--no-anchor") o.anchor_orientation = false;
+    else if (a == "--coast") o.orientation.coast_blank_walls = true;
+    else if (a == "--translation-given-rotation") o.orientation.translation_given_rotation = true;
+    else if (a == "--drift-floor" && i + 1 < argc)
+      o.orientation.drift_floor_deg = std::atof(argv[++i]);
+    else if (a == "--direction-floor" && i + 1 < argc)
+      o.orientation.map.min_direction_sigma_deg = std::atof(argv[++i]);
     else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
@@ -270,6 +276,8 @@ int run(int argc, char** argv) {
       stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0;
+  // How the map of world directions served the estimated frames (as eval_trajectory prints it).
+  int held = 0, reacquired = 0, rejected = 0, blank = 0, coasted = 0, overruled = 0;
   double lines_sum = 0.0, inliers_sum = 0.0;
   const auto run_start = std::chrono::steady_clock::now();
   for (int i = 0; i < frames; ++i) {
@@ -344,6 +352,22 @@ int run(int argc, char** argv) {
           const Eigen::Vector3d w = (gt[i].R_wc * v.d2).normalized().cwiseAbs();
           std::printf(" %.3f", std::acos(std::min(1.0, w.maxCoeff())) * 180.0 / M_PI);
         }
+        // Each VP as a direction of the ground truth's world (sign: largest component positive),
+        // with its segments: where the scene's directions are and how much the VPs scatter.
+        std::printf("\n   VP directions in the true world:");
+        for (size_t k = 0; k < r.matches.vps.size(); ++k) {
+          Eigen::Vector3d w = (gt[i].R_wc * r.matches.vps[k].d2).normalized();
+          int largest;
+          w.cwiseAbs().maxCoeff(&largest);
+          if (w[largest] < 0.0) w = -w;
+          int support = 0;
+          for (int label : r.matches.line_vp) support += label == static_cast<int>(k);
+          std::printf(" (%.4f %.4f %.4f; %d%s)", w.x(), w.y(), w.z(), support,
+                      k < r.estimate.estimate.vp_inliers.size() &&
+                              !r.estimate.estimate.vp_inliers[k]
+                          ? ", outlier"
+                          : "");
+        }
         // Anywhere: each VP match's disagreement with the true relative rotation, and its
         // number of segments.
         const int reference = frame_of(r.reference_stamp);
@@ -362,16 +386,27 @@ int run(int argc, char** argv) {
           }
         }
       }
-      std::printf("\n   tracks:");
-      for (const VpTrack& t : vo.vp_tracker().tracks()) {
-        // In a Manhattan world: the track's angle to the nearest world axis (odometry = camera 0).
+      std::printf("\n   orientation: %s%s, %d map directions paired, correction %.3f deg%s",
+                  to_string(r.orientation.source), r.orientation.blank_wall ? ", blank wall" : "",
+                  r.orientation.location.paired, r.orientation.correction_deg,
+                  r.orientation.location.ambiguous ? ", ambiguous" : "");
+      std::printf("\n   map:");
+      for (const MapDirection& t : vo.direction_map().directions()) {
+        // In a Manhattan world: the direction's angle to the nearest world axis (odometry = camera 0).
+        // Anywhere: the direction in the ground truth's world (compare with the VPs' there).
         double axis_error = NAN;
+        Eigen::Vector3d world = Eigen::Vector3d::Constant(NAN);
         if (!gt.empty()) {
-          const Eigen::Vector3d w = (gt[0].R_wc * t.direction).normalized().cwiseAbs();
-          axis_error = std::acos(std::min(1.0, w.maxCoeff())) * 180.0 / M_PI;
+          world = (gt[0].R_wc * t.direction).normalized();
+          int largest;
+          const double m = world.cwiseAbs().maxCoeff(&largest);
+          if (world[largest] < 0.0) world = -world;
+          axis_error = std::acos(std::min(1.0, m)) * 180.0 / M_PI;
         }
-        std::printf(" [%d: sigma %.4f, hits %d, chi2 %.2f%s, axis %.3f]", t.id, t.sigma_deg(),
-                    t.hits, t.last_chi2, t.last_gate_passed ? "" : " FAILED", axis_error);
+        std::printf(" [%d: sigma %.4f, hits %d, chi2 %.2f%s%s, axis %.3f, true world %.4f %.4f %.4f]",
+                    t.id, t.sigma_deg(), t.hits, t.last_chi2, t.confirmed ? "" : " candidate",
+                    t.disagreements ? " DISAGREES" : "", axis_error, world.x(), world.y(),
+                    world.z());
       }
       if (static_cast<int>(gt.size()) > i)
       {
@@ -399,6 +434,13 @@ int run(int argc, char** argv) {
     stereo_ms.push_back(r.stages.stereo_ms);
     if (r.status != VoStatus::kOk) continue;
     ++ok;
+    const OrientationSource source = r.orientation.source;
+    held += source == OrientationSource::kMap || source == OrientationSource::kReacquired;
+    reacquired += source == OrientationSource::kReacquired;
+    coasted += source == OrientationSource::kCoasted;
+    overruled += source == OrientationSource::kPairRejected;
+    rejected += r.orientation.location.ambiguous || r.orientation.location.rejected;
+    blank += r.orientation.blank_wall;
     if (stereo)
       scaled.push_back(r.stereo_scale.status == StereoScaleStatus::kOk ? 1.0 : 0.0);
     line_matches.push_back(r.num_line_matches);
@@ -438,6 +480,12 @@ int run(int argc, char** argv) {
               "inliers)\n",
               median(junctions), median(junction_inliers), median(vp_matches),
               median(vp_inliers));
+  int confirmed = 0;
+  for (const MapDirection& d : vo.direction_map().directions()) confirmed += d.confirmed;
+  std::printf("# map of directions: %d confirmed directions at the end; of %d estimated frames "
+              "%d held by the map, %d re-acquisitions, %d corrections rejected, %d blank walls "
+              "(%d coasted), %d pairs overruled\n",
+              confirmed, ok, held, reacquired, rejected, blank, coasted, overruled);
   if (!pose_errors.empty()) {
     const evaluation::TrajectoryErrors te =
         evaluation::compare_trajectories(estimate, truth, !stereo, 0.01);

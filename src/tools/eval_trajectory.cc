@@ -142,6 +142,29 @@ bool read_gt(const std::string& path, const std::string& topic, Trajectory* gt, 
   return true;
 }
 
+// How the map of world directions served the estimated frames, as bench_frontend prints it.
+void print_map_summary(const std::vector<hybrid_vo::MotionEstimate>& motions) {
+  using M = hybrid_vo::MotionEstimate;
+  int estimated = 0, held = 0, reacquired = 0, rejected = 0, blank = 0, coasted = 0,
+      overruled = 0, directions = 0;
+  for (const M& m : motions) {
+    if (m.status != M::STATUS_OK) continue;
+    ++estimated;
+    held += m.orientation_source == M::ORIENTATION_MAP ||
+            m.orientation_source == M::ORIENTATION_REACQUIRED;
+    reacquired += m.orientation_source == M::ORIENTATION_REACQUIRED;
+    coasted += m.orientation_source == M::ORIENTATION_COASTED;
+    overruled += m.orientation_source == M::ORIENTATION_PAIR_REJECTED;
+    rejected += m.map_correction_rejected;
+    blank += m.blank_wall;
+    directions = m.map_directions;
+  }
+  std::printf("# map of directions: %d confirmed directions at the end; of %d estimated frames "
+              "%d held by the map, %d re-acquisitions, %d corrections rejected, %d blank walls "
+              "(%d coasted), %d pairs overruled\n",
+              directions, estimated, held, reacquired, rejected, blank, coasted, overruled);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -325,6 +348,7 @@ int main(int argc, char** argv) {
     }
     std::printf("# frames answered: %zu, of %zu ground-truth poses\n", run.motions.size(),
                 gt.size());
+    print_map_summary(run.motions);
     std::printf("# per frame (median): front end %.1f ms, estimator %.1f ms, total %.1f ms = %.1f "
                 "frames/s\n",
                 median(frontend), median(estimator), median(total),

@@ -28,7 +28,7 @@ struct VpMatch {
 };
 
 // What is known about a VP match's direction in camera 1 before this pair, e.g. from a VP tracked
-// over earlier frames (VpTracker::priors): a prior, not a constraint. The estimator tests it
+// over earlier frames (DirectionMap::priors): a prior, not a constraint. The estimator tests it
 // against the pair's point-supported rotation and, when it passes, the final refinement pulls the
 // VP's direction towards it with its covariance.
 struct VpPrior {

@@ -19,7 +19,6 @@
 #include "hybrid_vo/frontend/vo_orientation.h"
 #include "hybrid_vo/frontend/worker_thread.h"
 #include "hybrid_vo/lines/two_view.h"
-#include "hybrid_vo/lines/vp_tracker.h"
 
 namespace hybrid_vo {
 
@@ -60,16 +59,17 @@ struct VisualOdometryOptions {
   // which shortens the scale (affine_tracking.h). The pose keeps the tracker's points.
   bool stereo_refine_tracks = true;
   AffineTrackingOptions stereo_track_refinement;
+  // The map of world directions (lines/direction_map.h): the pairs' VPs kept as landmarks in the
+  // odometry frame, priors for the next pair's VPs, and (anchor_orientation) the absolute
+  // reference that corrects each frame's orientation, predicted by the pair's rotation, wherever
+  // the camera sees its directions; found again by their structure after a blank wall. Each
+  // pair's rotation covariance grows the orientation's uncertainty (plus rotation_drift_floor_deg
+  // per axis): it tells a pair whose points barely separate rotation from translation (white
+  // panels seen from 2 m: 0.08 deg) from a well conditioned one (KITTI: 0.003 deg), where VPs,
+  // with their tenths of a degree of noise, must not move it.
   bool use_vp_tracker = true;
-  VpTrackerOptions vp_tracker;
-  // Orientation anchoring (VpTracker::anchor): each frame's orientation, predicted by the pair's
-  // rotation, is corrected by the confident VP tracks it sees. The prediction's uncertainty grows
-  // per pair by the estimator's rotation covariance plus rotation_drift_floor_deg per axis. That
-  // covariance tells a pair whose points barely separate rotation from translation (white panels
-  // seen from 2 m: 0.08 deg) from a well conditioned one (KITTI: 0.003 deg), where VPs, with
-  // their tenths of a degree of noise, must not move it.
   bool anchor_orientation = true;
-  double rotation_drift_floor_deg = 0.005;
+  OrientationFilterOptions orientation;
 };
 
 // Its own fields, the KLT tracker's under klt_, the estimator's (with the VP detection in front)
@@ -83,8 +83,10 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   visit("max_features", o.features.points.max_features, positive());
   visit_fields(o.klt, prefixed("klt_", visit));
   visit_fields(o.estimator, prefixed("estimator_", visit));
-  HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches,
-                  o.rotation_drift_floor_deg);
+  HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches);
+  visit("rotation_drift_floor_deg", o.orientation.drift_floor_deg, non_negative());
+  visit("coast_blank_walls", o.orientation.coast_blank_walls);
+  visit("translation_given_rotation", o.orientation.translation_given_rotation);
   HYBRID_VO_FIELDS(positive(), o.mono_scale);
   visit("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines, non_negative());
   visit("stereo_offset_calibration", o.stereo_offset.enabled);
@@ -143,10 +145,10 @@ struct VisualOdometryResult {
   Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
-  std::vector<int> vp_track_ids; // per VP match of the pair: the track of its prior, or -1
-  // Per VP the pose accepted, as seen in the current image: its track and the tracker's gate.
-  std::vector<VpAssociation> vp_associations;
-  AnchoredOrientation anchoring;  // with anchor_orientation: how the tracks corrected this frame
+  std::vector<int> vp_track_ids; // per VP match of the pair: the map direction of its prior, or -1
+  // How the map of directions placed this frame (with use_vp_tracker): the orientation's source,
+  // the directions each VP was paired with, blank wall, correction.
+  OrientationEstimate orientation;
   int num_point_matches = 0, num_line_matches = 0;
   LineTrackingStats line_tracking;  // with track_lines
   // Wall clock: image to matches, VPs + estimator, the whole frame; and per stage.
@@ -165,10 +167,10 @@ class VisualOdometry {
   void reset();
   // Starts a new keyframe chain at the next frame but keeps the pose: after a fault in the stream
   // (a time gap, a new image size, rejected frames) the motion across it is unknown, so nothing
-  // may be paired across it, yet the odometry goes on from where it was. VP tracks are dropped
-  // too: their directions would be compared under a rotation that no longer holds.
+  // may be paired across it, yet the odometry goes on from where it was. The map of directions is
+  // dropped too: its directions would be compared under a rotation that no longer holds.
   void restart();
-  const VpTracker& vp_tracker() const { return orientation_.vp_tracker(); }
+  const DirectionMap& direction_map() const { return orientation_.direction_map(); }
   const VisualOdometryOptions& options() const { return options_; }
 
  private:

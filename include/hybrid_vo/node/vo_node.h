@@ -226,10 +226,13 @@ class VoNode {
   // Stereo frames whose scale fell back to mono_scale, and the last reason.
   int stereo_scale_fallbacks_ = 0;
   std::string last_scale_fallback_;
-  // The VP tracker after the last frame, and its gates: priors the estimator used or rejected,
-  // and detections that failed their track's gate (VpTracker).
-  std::vector<VpTrack> vp_tracks_;
-  int vp_priors_used_ = 0, vp_priors_rejected_ = 0, vp_track_gate_failures_ = 0;
+  // The map of world directions after the last frame, and how it served: priors the estimator
+  // used or rejected, blank-wall frames, pairs whose rotation the map overruled (the map's own
+  // counters are in map_stats_).
+  std::vector<MapDirection> map_directions_;
+  DirectionStructure map_structure_;
+  DirectionMapStats map_stats_;
+  int vp_priors_used_ = 0, vp_priors_rejected_ = 0, blank_wall_frames_ = 0, pairs_overruled_ = 0;
 
   InjectedLeak injected_leak_;  // the soak's own test only (scripts/soak --leak)
 };
