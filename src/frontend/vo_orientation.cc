@@ -124,15 +124,12 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
   // A correction is the drift of earlier pairs, not this pair's motion: the translation stays as
   // this pair's points fixed it (re-fitted under the anchored rotation, it was 37 -> 51 deg off
   // on TUM fr3 structure_notexture). A rejected pair's rotation was wrong: its translation was
-  // fitted again under the map's, and that pose also scales the motion.
+  // fitted again under the map's (as every corrected pair's is with translation_given_rotation),
+  // and that pose also scales the motion.
   if (o.estimate.source != OrientationSource::kPair)
     o.pose.R = nearest_rotation(o.R_wc.transpose() * keyframe_R_wc);
-  if (o.estimate.source == OrientationSource::kPairRejected) {
-    o.pose.t = o.estimate.refit.pose.t;
-    o.scale_pose = o.pose;
-  } else if (o.estimate.refit.ok) {
-    o.pose.t = o.estimate.refit.pose.t;  // translation_given_rotation
-  }
+  if (o.estimate.refit.ok) o.pose.t = o.estimate.refit.pose.t;
+  if (o.estimate.source == OrientationSource::kPairRejected) o.scale_pose = o.pose;
   return o;
 }
 

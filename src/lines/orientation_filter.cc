@@ -77,14 +77,12 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
     coasted = pair;
     coasted.R = pair.last_motion_R;
   }
-  predict(R1, P1, coast ? coasted : pair, extra, &e.R_world_from_camera, &e.covariance);
+  Eigen::Matrix3d predicted, P;
+  predict(R1, P1, coast ? coasted : pair, extra, &predicted, &P);
+  if (!all_finite(predicted) || !all_finite(P)) return e;
+  e.R_world_from_camera = predicted;
+  e.covariance = P;
   if (coast) e.source = OrientationSource::kCoasted;
-  if (!all_finite(e.R_world_from_camera) || !all_finite(e.covariance)) {
-    e.R_world_from_camera = R1;
-    e.covariance = P1;
-    return e;
-  }
-  const Eigen::Matrix3d predicted = e.R_world_from_camera;
 
   if (options_.correct && judge(R1, P1, pair, extra, &e)) return e;
 
