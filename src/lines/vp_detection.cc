@@ -74,13 +74,17 @@ class VpFitter {
            static_cast<int>(active.size()) >= std::max(2, min_count())) {
       Model model;
       if (!ransac(active, &model)) break;
+      const std::vector<int> drawn = model.inliers;
       // Refit on the inliers and take the inliers again: the minimal sample is noisy.
       for (int round = 0; round < 2; ++round) {
         if (!fit_directions(model.inliers, &model)) break;
         model.inliers = inliers_of(model, active);
       }
+      // A refit can keep none of the hypothesis' items (three segments of a loose pencil whose
+      // length-weighted direction misses each of them). They leave the active set all the same:
+      // left in it, they would be drawn again, and again, forever.
       std::vector<char> taken(items_.size(), 0);
-      for (int i : model.inliers) taken[i] = 1;
+      for (int i : model.inliers.empty() ? drawn : model.inliers) taken[i] = 1;
       active.erase(std::remove_if(active.begin(), active.end(), [&](int i) { return taken[i]; }),
                    active.end());
       if (!enough(model.inliers)) continue;
