@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
 #include <hybrid_vo/FeatureLines.h>
 #include <hybrid_vo/FeaturePoints.h>
 #include <hybrid_vo/MotionEstimate.h>
@@ -26,6 +27,7 @@
 
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/render/camera_path.h"
+#include "ros_connections.h"
 
 namespace hybrid_vo {
 namespace testing {
@@ -73,13 +75,12 @@ class NodeHarness {
     vps_sub_ = nh.subscribe("hybrid_vo/vanishing_points", 100, &NodeHarness::on_vps, this);
   }
 
-  bool wait_for_node(double seconds = 20.0) {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < end) {
-      if (left_.getNumSubscribers() > 0 && left_info_.getNumSubscribers() > 0) return true;
-      ros::WallDuration(0.05).sleep();
-    }
-    return false;
+  // Waits until the node takes the left camera's topics (and `also`) and the harness hears the
+  // node's outputs.
+  ::testing::AssertionResult wait_for_node(const std::vector<ros::Publisher>& also = {}) {
+    std::vector<std::pair<ros::Publisher, uint32_t>> inputs = {{left_, 1}, {left_info_, 1}};
+    for (const ros::Publisher& p : also) inputs.emplace_back(p, 1);
+    return wait_connected(inputs, {motion_sub_, diagnostics_sub_, vps_sub_});
   }
 
   // Waits for the ~relative_pose message of `stamp`.

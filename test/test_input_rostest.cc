@@ -83,6 +83,7 @@ class Nodes {
     return false;
   }
 
+  const std::vector<ros::Subscriber>& subscribers() const { return subscribers_; }
   const std::map<ros::Time, MotionEstimate>& answers(const std::string& name) const {
     return answers_.at(name);
   }
@@ -114,32 +115,26 @@ class Nodes {
   std::vector<ros::Subscriber> subscribers_;
 };
 
-// Publishers of a topic per name, that wait until the nodes subscribe.
+// Publishers of a topic per name, each with the number of nodes that take it.
 class Topics {
  public:
   template <class M>
-  void add(const std::string& topic) {
-    publishers_[topic] = ros::NodeHandle().advertise<M>(topic, 5);
+  void add(const std::string& topic, uint32_t subscribers = 1) {
+    publishers_[topic] = {ros::NodeHandle().advertise<M>(topic, 5), subscribers};
   }
   template <class M>
   void publish(const std::string& topic, const M& message) {
-    publishers_.at(topic).publish(message);
+    publishers_.at(topic).first.publish(message);
   }
-  bool wait_for_subscribers(double seconds = 20.0) const {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < end) {
-      bool all = true;
-      for (const auto& [topic, publisher] : publishers_) all = all && publisher.getNumSubscribers() > 0;
-      if (all) return true;
-      ros::WallDuration(0.05).sleep();
-    }
-    for (const auto& [topic, publisher] : publishers_)
-      if (publisher.getNumSubscribers() == 0) ADD_FAILURE() << "nobody subscribes " << topic;
-    return false;
+  // Waits until every node takes its topics and `nodes` hears every node.
+  ::testing::AssertionResult wait_connected(const Nodes& nodes) const {
+    std::vector<std::pair<ros::Publisher, uint32_t>> publishers;
+    for (const auto& [topic, publisher] : publishers_) publishers.push_back(publisher);
+    return testing::wait_connected(publishers, nodes.subscribers());
   }
 
  private:
-  std::map<std::string, ros::Publisher> publishers_;
+  std::map<std::string, std::pair<ros::Publisher, uint32_t>> publishers_;
 };
 
 sensor_msgs::CompressedImage compressed_of(const cv::Mat& gray, const ros::Time& stamp,
@@ -208,14 +203,17 @@ render::Sequence corridor(int frames, int width = 480, int height = 360) {
 const std::vector<std::string> kCompressedNodes = {"raw_mono",   "png_mono",   "jpeg_mono",
                                                    "raw_stereo", "png_stereo", "jpeg_stereo"};
 
-// Every frame as raw images, PNG and JPEG, left and right, with the camera_infos they share.
+// Every frame as raw images, PNG and JPEG, left and right, with the camera_infos they share: a
+// left topic goes to a mono and a stereo node (a left camera_info to all six), a right one to a
+// stereo node (a right camera_info to all three).
 Topics compressed_topics() {
   Topics topics;
   for (const std::string side : {"left", "right"}) {
-    topics.add<sensor_msgs::Image>("camera/" + side + "/image_raw");
-    topics.add<sensor_msgs::CameraInfo>("camera/" + side + "/camera_info");
+    const uint32_t nodes = side == "left" ? 2 : 1;
+    topics.add<sensor_msgs::Image>("camera/" + side + "/image_raw", nodes);
+    topics.add<sensor_msgs::CameraInfo>("camera/" + side + "/camera_info", 3 * nodes);
     for (const std::string codec : {"png", "jpeg"})
-      topics.add<sensor_msgs::CompressedImage>(codec + "/" + side + "/image_raw/compressed");
+      topics.add<sensor_msgs::CompressedImage>(codec + "/" + side + "/image_raw/compressed", nodes);
   }
   return topics;
 }
@@ -245,7 +243,7 @@ TEST(Compressed, PngGivesTheRawPosesAndJpegTheirAccuracy) {
   const render::Sequence seq = corridor(120, 640, 480);
   Nodes nodes(kCompressedNodes);
   Topics topics = compressed_topics();
-  ASSERT_TRUE(topics.wait_for_subscribers());
+  ASSERT_TRUE(topics.wait_connected(nodes));
   nodes.spin_for(0.5);
   for (int i = 0; i < seq.options.frames; ++i) {
     const ros::Time stamp(1.0 + i / seq.options.rate);
@@ -296,7 +294,7 @@ TEST(Compressed, DamagedPayloadsAreCountedAndSkipped) {
   const render::Sequence seq = corridor(9);
   Nodes nodes(kCompressedNodes);
   Topics topics = compressed_topics();
-  ASSERT_TRUE(topics.wait_for_subscribers());
+  ASSERT_TRUE(topics.wait_connected(nodes));
   const double t0 = 100.0;  // after the other test's stamps
   std::vector<cv::Mat> left, right;
   for (int i = 0; i < 9; ++i) {
@@ -422,7 +420,7 @@ TEST(Fisheye, RectifiedFisheyeTracksAsWellAsThePinhole) {
     topics.add<sensor_msgs::Image>(name + "/image_raw");
     topics.add<sensor_msgs::CameraInfo>(name + "/camera_info");
   }
-  ASSERT_TRUE(topics.wait_for_subscribers());
+  ASSERT_TRUE(topics.wait_connected(nodes));
   nodes.spin_for(0.5);
   for (int i = 0; i < pinhole.options.frames; ++i) {
     const ros::Time stamp(1.0 + i / pinhole.options.rate);
@@ -477,7 +475,7 @@ TEST(Fisheye, BadCameraInfoIsCountedAndSkipped) {
   Topics topics;
   topics.add<sensor_msgs::Image>("fisheye/image_raw");
   topics.add<sensor_msgs::CameraInfo>("fisheye/camera_info");
-  ASSERT_TRUE(topics.wait_for_subscribers());
+  ASSERT_TRUE(topics.wait_connected(nodes));
   const double t0 = 100.0;  // after the other test's stamps
   auto publish = [&](int i, const std::function<void(sensor_msgs::CameraInfo*)>& damage) {
     const ros::Time stamp(t0 + i / seq.options.rate);

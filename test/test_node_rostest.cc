@@ -62,7 +62,7 @@ TEST(Replay, RenderedStereoSequence) {
   options.supersampling = 2;
   const render::Sequence seq = render::make_sequence(options);
   NodeHarness h;
-  ASSERT_TRUE(h.wait_for_node());
+  ASSERT_TRUE(h.wait_for_node({h.right_, h.right_info_}));
   publish_static_camera(&h);
   h.spin_for(0.5);
   double path = 0.0;
@@ -181,7 +181,7 @@ TEST(FeatureTopics, EstimatorUsesTheGivenFeatures) {
   const render::Sequence seq = render::make_sequence(options);
   const RenderedFeatures features = scene_features(seq.scene);
   NodeHarness h;
-  ASSERT_TRUE(h.wait_for_node());
+  ASSERT_TRUE(h.wait_for_node({h.points_, h.lines_}));
   publish_static_camera(&h);
   h.spin_for(0.5);
   const cv::Mat black(options.height, options.width, CV_8UC1, cv::Scalar(0));

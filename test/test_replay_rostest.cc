@@ -24,6 +24,7 @@
 #include "hybrid_vo/conversion/kitti_to_bag.h"
 #include "hybrid_vo/conversion/lamar_to_bag.h"
 #include "hybrid_vo/geometry/pose_error.h"
+#include "ros_connections.h"
 
 namespace hybrid_vo {
 namespace {
@@ -73,11 +74,9 @@ class Replay {
   ::testing::AssertionResult run() {
     if (frames_.size() < 5)
       return ::testing::AssertionFailure() << "only " << frames_.size() << " frames";
-    if (!wait([&] {
-          return image_pub_.getNumSubscribers() > 0 && info_pub_.getNumSubscribers() > 0;
-        }))
-      return ::testing::AssertionFailure()
-             << "the node does not subscribe " << image_pub_.getTopic();
+    const ::testing::AssertionResult connected =
+        testing::wait_connected({{image_pub_, 1}, {info_pub_, 1}}, {motion_sub_, odometry_sub_});
+    if (!connected) return connected;
     static_pub_.publish(statics_);
     spin_for(0.5);
     for (const Frame& frame : frames_) {
