@@ -234,9 +234,10 @@ void publish_frame(Topics* topics, const render::Sequence& seq, const ros::Time&
 }
 
 // PNG is lossless: its poses must be the raw ones, bit for bit. JPEG at quality 95 changes the
-// pixels about as much as the renderer's sensor noise: it may cost at most 1 point of AUC@10.
-// (It may also gain: on this sequence it is 1.1 points better; over eight noise seeds of it,
-// offline, JPEG - raw was -1.4 to +0.2, mean -0.8: chance moves one sequence by about 0.5.)
+// pixels about as much as the renderer's sensor noise, so its AUC@10 is the raw one's give or take
+// chance: over eight noise seeds of this walk, offline, JPEG - raw was -1.4 to +0.2 (mean -0.8),
+// and where in that spread one machine lands can differ from another's. The test bounds the
+// loss at 2 points, beyond that spread: it is there for a decoder that damages the images.
 TEST(Compressed, PngGivesTheRawPosesAndJpegTheirAccuracy) {
   // The demo's sequence (120 frames, 640 x 480): over fewer frames or smaller images, a pair or
   // two that RANSAC decides differently moves AUC@10 by points.
@@ -267,7 +268,7 @@ TEST(Compressed, PngGivesTheRawPosesAndJpegTheirAccuracy) {
     const double auc_jpeg = auc10(nodes.answers("jpeg_" + mode), seq, &ok_jpeg);
     EXPECT_GE(ok_raw, seq.options.frames * 3 / 4) << "too few poses for a comparison";
     EXPECT_EQ(auc_png, auc_raw);
-    EXPECT_GE(auc_jpeg, auc_raw - 1.0);
+    EXPECT_GE(auc_jpeg, auc_raw - 2.0);
     std::printf("%s: AUC@10 raw %.2f (%d OK), PNG %.2f (%d OK), JPEG q95 %.2f (%d OK), JPEG - raw "
                 "%+.2f\n",
                 mode.c_str(), auc_raw, ok_raw, auc_png, ok_png, auc_jpeg, ok_jpeg,
