@@ -26,10 +26,12 @@ inline ::testing::AssertionResult wait_connected(
     std::string missing;
     for (const auto& [publisher, wanted] : publishers)
       if (publisher.getNumSubscribers() < wanted)
-        missing += " " + publisher.getTopic() + " (" + std::to_string(publisher.getNumSubscribers()) +
-                   " of " + std::to_string(wanted) + " subscribers)";
+        missing += " " + publisher.getTopic() + " (" +
+                   std::to_string(publisher.getNumSubscribers()) + " of " +
+                   std::to_string(wanted) + " subscribers)";
     for (const ros::Subscriber& subscriber : subscribers)
-      if (subscriber.getNumPublishers() == 0) missing += " " + subscriber.getTopic() + " (no publisher)";
+      if (subscriber.getNumPublishers() == 0)
+        missing += " " + subscriber.getTopic() + " (no publisher)";
     if (missing.empty()) return ::testing::AssertionSuccess();
     if (!ros::ok() || ros::WallTime::now() >= end)
       return ::testing::AssertionFailure() << "not connected after " << seconds << " s:" << missing;

@@ -255,8 +255,11 @@ TEST(Faults, EachFaultIsCountedAndRecoveredFrom) {
     }
   }
   // Frames are paired in order everywhere.
-  for (const MotionEstimate& m : h.received_)
-    if (m.status == MotionEstimate::STATUS_OK) EXPECT_LT(m.reference_stamp, m.header.stamp);
+  for (const MotionEstimate& m : h.received_) {
+    if (m.status == MotionEstimate::STATUS_OK) {
+      EXPECT_LT(m.reference_stamp, m.header.stamp);
+    }
+  }
 
   std::string table;
   for (const Fault& f : faults) {
@@ -367,7 +370,9 @@ TEST(Overload, DropsTheOldestCountsEveryFrameAndBoundsLatency) {
   for (size_t j = first; j < h.received_.size(); ++j) {
     const MotionEstimate& m = h.received_[j];
     EXPECT_GE(m.header.stamp, first_stamp);
-    if (j > first) EXPECT_LT(h.received_[j - 1].header.stamp, m.header.stamp);
+    if (j > first) {
+      EXPECT_LT(h.received_[j - 1].header.stamp, m.header.stamp);
+    }
     if (m.status != MotionEstimate::STATUS_OK) continue;
     EXPECT_LT(m.reference_stamp, m.header.stamp);
     EXPECT_TRUE(h.motions_.count(m.reference_stamp)) << "reference never answered";
