@@ -232,9 +232,16 @@ class Player {
     spinner.start();
     if (!statics_.transforms.empty()) static_pub_.publish(statics_);
     const Clock::time_point wait_end = Clock::now() + std::chrono::seconds(30);
-    while (ros::ok() && (image_pub_.getNumSubscribers() == 0 || info_pub_.getNumSubscribers() == 0)) {
+    // Both ends of every topic: an answer sent before this subscription connects is lost, and
+    // would count as a dropped frame.
+    auto connected = [&] {
+      return image_pub_.getNumSubscribers() > 0 && info_pub_.getNumSubscribers() > 0 &&
+             motion_sub_.getNumPublishers() > 0;
+    };
+    while (ros::ok() && !connected()) {
       if (Clock::now() > wait_end) {
-        std::cerr << "soak: the node does not subscribe " << prefix << "/image_raw\n";
+        std::cerr << "soak: the node does not subscribe " << prefix
+                  << "/image_raw or does not publish ~relative_pose\n";
         return 1;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
