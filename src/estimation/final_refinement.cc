@@ -1,6 +1,7 @@
 #include "hybrid_vo/estimation/final_refinement.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <utility>
@@ -310,6 +311,36 @@ bool prior_whitening(const VpPrior& prior, Eigen::Vector3d* p, Eigen::Matrix<dou
 
 bool usable_sigma(double sigma) { return sigma > 0.0 && std::isfinite(sigma); }
 
+// J^T J of each kind of residual, in Ceres' tangent [d (quaternion), u, VP directions], as an
+// InformationSplit in [w = 2 d, u, ...], the points' and the segments' with their own variance
+// factors.
+InformationSplit split_information(const Eigen::MatrixXd& points, const Eigen::MatrixXd& segments,
+                                   const Eigen::MatrixXd& priors, double point_factor,
+                                   double segment_factor,
+                                   const Eigen::Matrix<double, 3, 2, Eigen::RowMajor>& t_basis) {
+  InformationSplit split;
+  const int n = static_cast<int>(points.rows());
+  if (n < 5 || !(point_factor > 0.0) || !(segment_factor > 0.0)) return split;
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(n);
+  scale.head<3>().setConstant(0.5);  // d = w / 2
+  const Eigen::MatrixXd S = scale.asDiagonal();
+  const Eigen::Matrix<double, 5, 5> pose_points = (S * points * S).topLeftCorner<5, 5>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> eigen(pose_points);
+  if (eigen.info() != Eigen::Success ||
+      !(eigen.eigenvalues()(0) > 1e-10 * eigen.eigenvalues()(4)))
+    return split;
+  split.points_covariance = point_factor * eigen.eigenvectors() *
+                            eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                            eigen.eigenvectors().transpose();
+  split.segment_information = S * segments * S / segment_factor;
+  split.prior_information = S * priors * S;
+  split.to_pose.topLeftCorner<3, 3>().setIdentity();
+  split.to_pose.bottomRightCorner<3, 2>() = t_basis;
+  split.valid = all_finite(split.points_covariance) && all_finite(split.segment_information) &&
+                all_finite(split.prior_information);
+  return split;
+}
+
 bool is_rotation(const Eigen::Matrix3d& R) {
   return all_finite(R) && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-6 &&
          R.determinant() > 0.0;
@@ -393,6 +424,9 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
   // that a block's Jacobian stays in the cache.
   constexpr size_t kBlock = 64;
   std::vector<PointBlockSampsonCost::Match> block;
+  // What each residual row measures, in the order the rows are added (= Ceres' row order).
+  enum RowKind : char { kPointRow, kSegmentRow, kPriorRow };
+  std::vector<char> row_kind;
   auto flush = [&] {
     if (block.empty()) return;
     if (result.num_point_residuals == static_cast<int>(block.size()))
@@ -407,6 +441,7 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
     block.push_back({homogeneous(camera1.normalize(m.x1)), homogeneous(camera2.normalize(m.x2)),
                      1.0 / sigma, point_loss ? options.point_loss_px / sigma : 0.0});
     ++result.num_point_residuals;
+    row_kind.push_back(kPointRow);
     if (block.size() == kBlock) flush();
   }
   flush();
@@ -457,6 +492,7 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
                                  nullptr, directions[k].data());
         ++result.num_vp_priors;
         prior_rows += 2;
+        row_kind.insert(row_kind.end(), 2, kPriorRow);
       }
       const bool skip_view1 = prior && data.vp_priors[k].includes_view1;
       for (int i : labelled[k]) {
@@ -468,6 +504,7 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
               new LineFreeVpCost(second ? K2 : K1, segment, second, line_scale_k), line_loss_k, q,
               directions[k].data());
           ++result.num_line_residuals;
+          row_kind.push_back(kSegmentRow);
         }
       }
       continue;
@@ -477,17 +514,20 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
           new VpAngleCost(d1, d2, vps[k].sign_known, vp_scale / scale),
           scale == 1.0 ? vp_loss : cauchy(options.vp_loss_deg, options.vp_sigma_deg * scale), q);
       ++result.num_vp_residuals;
+      row_kind.insert(row_kind.end(), 3, kSegmentRow);
     }
     for (int i : labelled[k]) {
       if (usable_segment(lines[i].s2)) {
         problem.AddResidualBlock(new LineVpCost(K2, lines[i].s2, d1, false, line_scale_k),
                                  line_loss_k, q);
         ++result.num_line_residuals;
+        row_kind.push_back(kSegmentRow);
       }
       if (usable_segment(lines[i].s1)) {
         problem.AddResidualBlock(new LineVpCost(K1, lines[i].s1, d2, true, line_scale_k),
                                  line_loss_k, q);
         ++result.num_line_residuals;
+        row_kind.push_back(kSegmentRow);
       }
     }
   }
@@ -531,9 +571,8 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
     return result;
   // (J^T J)^-1 in the tangent spaces of all parameter blocks, from the robustified Jacobian at the
   // optimum (what ceres::Covariance computes, without its setup cost: 40 % of a refinement of
-  // 1500 points). The [q, t] block of the inverse marginalises the free VP directions. Rank
-  // deficient (an eigenvalue of J^T J below 1e-10 of the largest, i.e. a singular value of J
-  // below 1e-5): no covariance.
+  // 1500 points). Its [q, t] block marginalises the free VP directions. A pose block that is rank
+  // deficient (an eigenvalue below 1e-10 of the largest): no covariance.
   std::vector<double*> blocks = {q, t};
   for (size_t k = 0; k < vps.size(); ++k)
     if (problem.HasParameterBlock(directions[k].data())) blocks.push_back(directions[k].data());
@@ -542,23 +581,44 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
   evaluate_options.apply_loss_function = true;
   evaluate_options.num_threads = 1;
   ceres::CRSMatrix crs;
-  if (!problem.Evaluate(evaluate_options, nullptr, nullptr, nullptr, &crs)) return result;
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(crs.num_cols, crs.num_cols);
+  std::vector<double> residuals;
+  if (!problem.Evaluate(evaluate_options, nullptr, &residuals, nullptr, &crs)) return result;
+  // J^T J by the kind of row (upper triangles), and their sum.
+  const bool kinds_known = static_cast<int>(row_kind.size()) == crs.num_rows;
+  std::array<Eigen::MatrixXd, 3> by_kind;
+  for (Eigen::MatrixXd& part : by_kind) part = Eigen::MatrixXd::Zero(crs.num_cols, crs.num_cols);
   for (int row = 0; row < crs.num_rows; ++row) {
+    Eigen::MatrixXd& part = by_kind[kinds_known ? row_kind[row] : kSegmentRow];
     for (int a = crs.rows[row]; a < crs.rows[row + 1]; ++a)
       for (int b = a; b < crs.rows[row + 1]; ++b)
-        H(crs.cols[a], crs.cols[b]) += crs.values[a] * crs.values[b];
+        part(crs.cols[a], crs.cols[b]) += crs.values[a] * crs.values[b];
   }
-  H = H.selfadjointView<Eigen::Upper>();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(H);
-  if (eigen.info() != Eigen::Success || crs.num_cols < 5 ||
-      !(eigen.eigenvalues()(0) > 1e-10 * eigen.eigenvalues()(crs.num_cols - 1)))
+  for (Eigen::MatrixXd& part : by_kind) part = part.selfadjointView<Eigen::Upper>();
+  const Eigen::MatrixXd H = by_kind[kPointRow] + by_kind[kSegmentRow] + by_kind[kPriorRow];
+  // The pose's block of the inverse: the Schur complement of the VP directions, which may be
+  // unfixed themselves (a direction seen along one segment) without the pose being so.
+  if (crs.num_cols < 5) return result;
+  Eigen::Matrix<double, 5, 5> schur = H.topLeftCorner<5, 5>();
+  if (crs.num_cols > 5) {
+    const int m = crs.num_cols - 5;
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> directions(H.bottomRightCorner(m, m));
+    if (directions.info() != Eigen::Success) return result;
+    Eigen::VectorXd inverse = directions.eigenvalues();
+    const double largest = std::max(0.0, inverse.maxCoeff());
+    for (int k = 0; k < m; ++k)
+      inverse(k) = inverse(k) > 1e-10 * largest && inverse(k) > 0.0 ? 1.0 / inverse(k) : 0.0;
+    const Eigen::MatrixXd B = H.topRightCorner(5, m);
+    schur -= B * directions.eigenvectors() * inverse.asDiagonal() *
+             directions.eigenvectors().transpose() * B.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 5, 5>> eigen(
+      0.5 * (schur + schur.transpose()));
+  if (eigen.info() != Eigen::Success ||
+      !(eigen.eigenvalues()(0) > 1e-10 * eigen.eigenvalues()(4)))
     return result;
-  const Eigen::MatrixXd inverse = eigen.eigenvectors() *
-                                  eigen.eigenvalues().cwiseInverse().asDiagonal() *
-                                  eigen.eigenvectors().transpose();
-  const Eigen::Matrix<double, 5, 5> symmetric = 0.5 * (inverse.topLeftCorner<5, 5>() +
-                                                       inverse.topLeftCorner<5, 5>().transpose());
+  const Eigen::Matrix<double, 5, 5> symmetric = eigen.eigenvectors() *
+                                                eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                                                eigen.eigenvectors().transpose();
   if (!all_finite(symmetric)) return result;
   // Tangent [d (quaternion), 2 sphere coordinates] to [w = 2 d, t]: t's tangent basis is the
   // sphere manifold's Plus Jacobian at t.
@@ -572,6 +632,22 @@ FinalRefinementResult refine_relative_pose_ceres(const PinholeCamera& camera1,
   if (!all_finite(full)) return result;
   result.covariance = 0.5 * (full + full.transpose());
   result.covariance_valid = true;
+  if (kinds_known && static_cast<int>(residuals.size()) == crs.num_rows) {
+    // Each source's own variance factor (variance component estimation): the points' residuals
+    // tell the points' noise, the segments' theirs; a prior's covariance is given, not measured.
+    std::array<double, 3> squares{}, rows_of{};
+    for (int row = 0; row < crs.num_rows; ++row) {
+      squares[row_kind[row]] += residuals[row] * residuals[row];
+      rows_of[row_kind[row]] += 1.0;
+    }
+    const double point_factor = squares[kPointRow] / std::max(1.0, rows_of[kPointRow] - 5.0);
+    const double segment_factor =
+        rows_of[kSegmentRow] > 2.0 * free_vps
+            ? squares[kSegmentRow] / (rows_of[kSegmentRow] - 2.0 * free_vps)
+            : 1.0;
+    result.split = split_information(by_kind[kPointRow], by_kind[kSegmentRow],
+                                     by_kind[kPriorRow], point_factor, segment_factor, t_basis);
+  }
   return result;
 }
 

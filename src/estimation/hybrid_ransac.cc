@@ -81,11 +81,25 @@ class LocalOptimizer {
   std::vector<Eigen::Vector3d> v1_, v2_;
 };
 
+// Keeps the hypotheses within `margin` of `best`, at most `cap` of the cheapest.
+void prune_near_best(double best, double margin, size_t cap, std::vector<ScoredRotation>* kept) {
+  kept->erase(std::remove_if(kept->begin(), kept->end(),
+                             [&](const ScoredRotation& h) { return !(h.cost < best + margin); }),
+              kept->end());
+  if (kept->size() <= cap) return;
+  std::nth_element(kept->begin(), kept->begin() + cap, kept->end(),
+                   [](const ScoredRotation& a, const ScoredRotation& b) { return a.cost < b.cost; });
+  kept->resize(cap);
+}
+
 }  // namespace
 
 HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,
-                                      const HybridRansacOptions& options, std::mt19937_64* rng) {
+                                      const HybridRansacOptions& options, std::mt19937_64* rng,
+                                      double near_best_margin, int max_near_best) {
   HybridRansacOutcome out;
+  const bool keep = near_best_margin > 0.0 && max_near_best > 0;
+  const size_t cap = static_cast<size_t>(std::max(0, max_near_best));
   MinimalSampler sampler(problem, rng);
   const ModelScorer scorer(problem, options.point_threshold_px, options.vp_threshold_deg * kDegree);
   LocalOptimizer optimizer(problem, scorer, options, rng);
@@ -178,7 +192,13 @@ HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,
       if (!(pose.t.squaredNorm() > 0.0)) continue;  // pure rotation: no epipolar geometry to score
       out.solvers[s].models++;
       out.any_model = true;
-      const double cost = scorer.cost(pose, out.best_cost);
+      // Scored to the margin only when hypotheses are kept: the early exit at the best cost is
+      // what makes scoring cheap.
+      const double cost = scorer.cost(pose, out.best_cost + (keep ? near_best_margin : 0.0));
+      if (keep && cost < out.best_cost + near_best_margin) {
+        out.near_best.push_back({pose.R, cost});
+        if (out.near_best.size() >= 2 * cap) prune_near_best(out.best_cost, near_best_margin, cap, &out.near_best);
+      }
       if (cost < out.best_cost) {
         out.best_cost = cost;
         out.best = pose;
@@ -208,6 +228,7 @@ HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,
           std::max(1e-3, static_cast<double>(scorer.line_support(out.best)) / valid_lines);
     refresh();
   }
+  if (keep) prune_near_best(out.best_cost, near_best_margin, cap, &out.near_best);
   return out;
 }
 

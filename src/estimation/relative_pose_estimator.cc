@@ -180,7 +180,7 @@ double vp_prior_chi2(const HybridProblem& problem, const TwoViewMatches& matches
 // those that pass pull a second refinement, which starts from the first.
 void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
                   const RelativePoseEstimatorOptions& options, const TwoViewMatches& matches,
-                  RelativePoseEstimate* est) {
+                  RelativePoseEstimate* est, InformationSplit* split) {
   std::vector<char> pool, vps;
   const int pool_before = scorer.pool_inliers(est->pose, &pool);
   scorer.vp_inliers(est->pose, &vps);
@@ -222,11 +222,22 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
     est->pose = r.pose;
     est->covariance = r.covariance;
     est->covariance_valid = r.covariance_valid;
+    *split = r.split;
     est->refined = true;
     return true;
   };
-  accept(refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose, refinement),
-         0.95);
+  const FinalRefinementResult first =
+      refine_relative_pose_ceres(problem.camera1, problem.camera2, data, est->pose, refinement);
+  if (!accept(first, 0.95) && first.success && first.covariance_valid) {
+    // The data's optimum lost inliers and the RANSAC model stays: its covariance is the
+    // optimum's curvature, widened by how far the model lies from it.
+    est->covariance = first.covariance;
+    const Eigen::AngleAxisd apart(Eigen::Matrix3d(first.pose.R * est->pose.R.transpose()));
+    const Eigen::Vector3d w = apart.angle() * apart.axis();
+    est->covariance.topLeftCorner<3, 3>() += w * w.transpose();
+    est->covariance_valid = all_finite(est->covariance);
+    *split = first.split;
+  }
 
   if (matches.vp_priors.size() != matches.vps.size() || data.vps.empty()) return;
   // Against a prior, which carries many frames, the pair's point matches are not independent
@@ -369,7 +380,12 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
 
   const auto ransac_start = std::chrono::steady_clock::now();
   std::mt19937_64 rng(options.ransac.seed);
-  const HybridRansacOutcome outcome = run_hybrid_ransac(problem, options.ransac, &rng);
+  const PairCovarianceOptions& honest = options.covariance;
+  const HybridRansacOutcome outcome =
+      honest.enabled
+          ? run_hybrid_ransac(problem, options.ransac, &rng, honest.hypothesis_margin,
+                              honest.max_hypotheses)
+          : run_hybrid_ransac(problem, options.ransac, &rng);
   est.ransac_ms = ms_since(ransac_start);
   est.solvers = outcome.solvers;
   est.iterations = outcome.iterations;
@@ -386,15 +402,35 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
     return finish(EstimationStatus::kNoModel);
 
   est.scales = measure_scales(problem, scorer, options, matches, est.pose);
+  InformationSplit split;
   if (options.refinement.enabled) {
     const auto refine_start = std::chrono::steady_clock::now();
-    refine_final(problem, scorer, options, matches, &est);
+    refine_final(problem, scorer, options, matches, &est, &split);
     est.refine_ms = ms_since(refine_start);
   }
   // The Sampson error cannot tell t from -t, and the minimal sample that fixed the sign was
   // tiny: the inliers vote on it (depths in front of both cameras).
   orient_by_inliers(problem, scorer, &est.pose);
   fill_inliers(problem, scorer, options, matches, &est);
+  est.hessian_covariance = est.covariance;
+  if (honest.enabled && est.covariance_valid) {
+    std::vector<RotationHypothesis> hypotheses;
+    for (const ScoredRotation& h : outcome.near_best) hypotheses.push_back({h.R, h.cost});
+    const double point_matches = est.num_point_inliers + est.num_junction_inliers;
+    const double temperature =
+        hypothesis_temperature(point_matches, honest.ambiguity_independent_points,
+                               est.scales.point_px, options.ransac.point_threshold_px);
+    est.rotation_spread =
+        rotation_spread(hypotheses, est.pose.R, outcome.best_cost, temperature);
+    if (!pair_covariance(split, est.rotation_spread, point_matches, est.num_line_inliers, honest,
+                         &est.covariance)) {
+      // The points alone do not fix the pose (too few, or VPs carry it): the refinement's
+      // covariance, its segments counted as independent_segments, and the spread.
+      est.covariance =
+          std::max(1.0, est.num_line_inliers / honest.independent_segments) * est.hessian_covariance;
+      est.covariance.topLeftCorner<3, 3>() += est.rotation_spread;
+    }
+  }
   return finish(EstimationStatus::kOk);
 }
 

@@ -84,6 +84,20 @@ struct RefinementData {
   std::vector<double> vp_sigma_scale;
 };
 
+// The refinement's information by source, at the optimum, for a covariance that weighs the
+// sources by what their residuals cannot show (pair_covariance.h). Coordinates: the pose tangent
+// [w (3, the left rotation increment), u (2, t = t0 + B u)] followed by two per refined VP
+// direction. The points' covariance and the segments' information carry each their own variance
+// factor (their whitened residuals' mean square); the priors' none (their covariance is given).
+struct InformationSplit {
+  bool valid = false;  // the point-like residuals alone fix the pose (their block is invertible)
+  Eigen::Matrix<double, 5, 5> points_covariance = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::MatrixXd segment_information;  // segment-to-VP and VP residuals
+  Eigen::MatrixXd prior_information;    // the VP priors' rows
+  // [w, t] = to_pose [w, u]: identity on w, B on u.
+  Eigen::Matrix<double, 6, 5> to_pose = Eigen::Matrix<double, 6, 5>::Zero();
+};
+
 struct FinalRefinementResult {
   // False when fewer than 5 residual rows (or fewer independent rows than free parameters, a VP
   // counting two) remain after skipping bad items, when the cameras, the options or the initial
@@ -105,6 +119,7 @@ struct FinalRefinementResult {
   // data that cannot separate t from a rotation).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_valid = false;
+  InformationSplit split;  // with the covariance
   double sigma2 = 0.0;  // the variance factor of the whitened residuals behind the covariance
   int iterations = 0;
   double initial_cost = 0.0, final_cost = 0.0;  // Ceres' cost, 1/2 sum of the whitened losses

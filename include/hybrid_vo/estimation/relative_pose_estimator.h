@@ -11,6 +11,7 @@
 #include "hybrid_vo/estimation/final_refinement.h"
 #include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/estimation/modality_scales.h"
+#include "hybrid_vo/estimation/pair_covariance.h"
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/geometry/option_fields.h"
 #include "hybrid_vo/geometry/pose.h"
@@ -85,6 +86,9 @@ struct RelativePoseEstimatorOptions {
   // all) from `refinement`.
   ModalityScaleOptions scales;
   FinalRefinementOptions refinement;
+  // The covariance reported (RelativePoseEstimate::covariance): the refinement's, weighed by
+  // what the pair's residuals cannot show (pair_covariance.h).
+  PairCovarianceOptions covariance;
   // A VP prior (TwoViewMatches::vp_priors) is used only when its direction, carried by the best
   // RANSAC model's rotation, agrees with the VP seen in image 2: the squared Mahalanobis distance
   // under both covariances must not exceed this (chi-square, 2 dof: 9.21 at 99 %).
@@ -106,6 +110,7 @@ void visit_fields(RelativePoseEstimatorOptions& o, Visit&& visit) {
                                       {"point_sigma_px", "line_vp_sigma_px", "vp_sigma_deg",
                                        "point_loss_px", "line_vp_loss_px", "vp_loss_deg"}));
   visit_fields(o.scales, prefixed("scales_", visit));
+  visit_fields(o.covariance, prefixed("covariance_", visit));
   HYBRID_VO_FIELDS(non_negative(), o.vp_prior_gate_chi2, o.min_point_inliers);
 }
 
@@ -131,8 +136,14 @@ struct SolverStatistics {
 struct RelativePoseEstimate {
   EstimationStatus status = EstimationStatus::kTooLittleData;
   RelativePose pose;  // unit t; identity/zero unless status == kOk
+  // Of [w, t]: w (3, rad) the left rotation increment R <- exp([w]x) R, t (3) the unit
+  // translation (rank 5). The pair's honest covariance (pair_covariance.h); the refinement's own,
+  // sigma^2 (J^T J)^-1, is hessian_covariance, and the spread of the competing rotations that
+  // widened it rotation_spread (rad^2).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   bool covariance_valid = false;
+  Eigen::Matrix<double, 6, 6> hessian_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix3d rotation_spread = Eigen::Matrix3d::Zero();
 
   // Inlier masks per data type, aligned with the inputs and the derived lists below.
   std::vector<char> point_inliers, line_inliers, vp_inliers;
