@@ -254,7 +254,7 @@ TEST(DirectionMap, PriorsComeFromConfirmedDirectionsSignedLikeD1) {
   matches[0].d1 = -(R1.transpose() * kX);
   matches[1].d1 = R1.transpose() * kY;
   for (const VpPrior& p : map.priors(R1, isotropic(0.01), matches)) EXPECT_FALSE(p.valid);
-  build(&map, {kX, kY}, 2, &rng);
+  build(&map, {kX, kY}, 4, &rng);  // seen 5 frames after the first: confirmed
   const std::vector<VpPrior> priors = map.priors(R1, isotropic(0.5), matches);
   ASSERT_EQ(priors.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
@@ -269,7 +269,7 @@ TEST(DirectionMap, PriorsComeFromConfirmedDirectionsSignedLikeD1) {
 TEST(DirectionMap, BadInputChangesNothingAndNeverGivesNan) {
   std::mt19937 rng(8);
   DirectionMap map;
-  build(&map, {kX, kY, kZ}, 5, &rng);
+  build(&map, {kX, kY, kZ}, 6, &rng);
   const std::vector<MapDirection> before = map.directions();
   const double nan = std::numeric_limits<double>::quiet_NaN();
   Eigen::Matrix3d bad_R = Eigen::Matrix3d::Identity();
@@ -304,7 +304,7 @@ TEST(DirectionMap, BadInputChangesNothingAndNeverGivesNan) {
 TEST(DirectionMap, DirectionsStayWhileUnseenAndIdsAreNeverReused) {
   std::mt19937 rng(9);
   DirectionMap map;
-  build(&map, {kX, kY, kZ}, 5, &rng);
+  build(&map, {kX, kY, kZ}, 6, &rng);
   std::vector<int> ids;
   for (const MapDirection& d : map.directions()) ids.push_back(d.id);
   build(&map, {}, 500, &rng);  // a long blank stretch
@@ -350,7 +350,7 @@ TEST(DirectionMap, CapOnTheNumberOfDirections) {
   DirectionMapOptions options;
   options.max_directions = 5;
   DirectionMap map(options);
-  build(&map, {kX, kY, kZ}, 5, &rng);
+  build(&map, {kX, kY, kZ}, 6, &rng);
   std::vector<Eigen::Vector3d> many = {kX, kY, kZ};
   for (int k = 0; k < 6; ++k)
     many.push_back(rotation_about(kY, (15.0 + 10.0 * k) * kDeg) * kX);

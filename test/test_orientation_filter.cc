@@ -38,11 +38,12 @@ std::vector<VpObservation> vps_of(const Eigen::Matrix3d& R) {
   return out;
 }
 
-// A filter whose map holds the triad, seen by 5 frames of known orientation.
+// A filter whose map holds the triad, seen by 6 frames of known orientation (a direction is
+// confirmed once seen 5 frames after its first sighting).
 OrientationFilter filter_with_triad() {
   OrientationFilter filter;
   const Eigen::Matrix3d P = std::pow(0.01 * kDeg, 2) * Eigen::Matrix3d::Identity();
-  for (int k = 0; k < 5; ++k) {
+  for (int k = 0; k < 6; ++k) {
     const Eigen::Matrix3d R = rotation_about(Eigen::Vector3d(0.1, 1, 0.2).normalized(), 0.02 * k);
     OrientationEstimate e;
     e.R_world_from_camera = R;

@@ -43,21 +43,26 @@ bool tangent_angle(const Eigen::Vector3d& world, const Eigen::Vector3d& m,
   return true;
 }
 
-bool pair_residual(const Eigen::Vector3d& world, const Eigen::Matrix3d& world_covariance,
-                   const MapLandmark& landmark, PairResidual* out) {
-  const Eigen::Vector3d& m = landmark.direction;
+bool residual_and_jacobian(const Eigen::Vector3d& world, const Eigen::Vector3d& m,
+                           Eigen::Vector2d* r, Eigen::Matrix<double, 2, 3>* H) {
   const Eigen::Matrix<double, 3, 2> B = tangent_basis(m);
-  if (!tangent_angle(world, m, B, &out->r)) return false;
+  if (!tangent_angle(world, m, B, r)) return false;
   // Central differences: the map is smooth away from 90 degrees, and a few pairs are cheap.
   constexpr double h = 1e-6;
   for (int a = 0; a < 3; ++a) {
     Eigen::Vector2d plus, minus;
-    const Eigen::Vector3d step = h * Eigen::Vector3d::Unit(a);
     if (!tangent_angle(rotation_about(Eigen::Vector3d::Unit(a), h) * world, m, B, &plus) ||
         !tangent_angle(rotation_about(Eigen::Vector3d::Unit(a), -h) * world, m, B, &minus))
       return false;
-    out->H.col(a) = (plus - minus) / (2.0 * step.norm());
+    H->col(a) = (plus - minus) / (2.0 * h);
   }
+  return true;
+}
+
+bool pair_residual(const Eigen::Vector3d& world, const Eigen::Matrix3d& world_covariance,
+                   const MapLandmark& landmark, PairResidual* out) {
+  if (!residual_and_jacobian(world, landmark.direction, &out->r, &out->H)) return false;
+  const Eigen::Matrix<double, 3, 2> B = tangent_basis(landmark.direction);
   out->S = B.transpose() * (landmark.covariance + world_covariance) * B;
   return true;
 }
@@ -204,6 +209,11 @@ std::vector<std::vector<int>> candidates_of(const Eigen::Matrix3d& R, const Eige
 }
 
 }  // namespace
+
+bool direction_residual(const Eigen::Vector3d& world, const Eigen::Vector3d& direction,
+                        Eigen::Vector2d* r, Eigen::Matrix<double, 2, 3>* H) {
+  return all_finite(world) && all_finite(direction) && residual_and_jacobian(world, direction, r, H);
+}
 
 double chi2_quantile_99(int dof) {
   static constexpr double kTable[] = {6.635,  9.210,  11.345, 13.277, 15.086, 16.812,

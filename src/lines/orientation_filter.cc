@@ -38,22 +38,36 @@ const char* to_string(OrientationSource source) {
 OrientationFilter::OrientationFilter(const OrientationFilterOptions& options)
     : options_(options), map_(options.map) {}
 
-void OrientationFilter::predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
-                                const PairRotation& pair, double extra_sigma_rad,
-                                Eigen::Matrix3d* R, Eigen::Matrix3d* P) const {
+JointOrientation OrientationFilter::predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
+                                            const PairRotation& pair, double extra_sigma_rad,
+                                            Eigen::Matrix3d* R, Eigen::Matrix3d* P) const {
   *R = nearest_rotation(R1 * pair.R.transpose());
   const double floor = options_.drift_floor_deg * kDeg;
-  *P = P1 + (floor * floor + extra_sigma_rad * extra_sigma_rad) * Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d Q =
+      (floor * floor + extra_sigma_rad * extra_sigma_rad) * Eigen::Matrix3d::Identity();
   // The pair's error as a left increment of R (camera 2) is -R_wc times it in the odometry frame.
-  if (all_finite(pair.covariance)) *P += *R * pair.covariance * R->transpose();
-  *P = 0.5 * (*P + P->transpose());
+  if (all_finite(pair.covariance)) Q += *R * pair.covariance * R->transpose();
+  const JointOrientation joint = map_.prediction(P1, 0.5 * (Q + Q.transpose()));
+  *P = joint.orientation();
+  return joint;
+}
+
+double OrientationFilter::blank_wall_sigma(const Eigen::Matrix3d& R) const {
+  const double turned = Eigen::AngleAxisd(nearest_rotation(R)).angle();
+  return std::hypot(options_.blank_wall_sigma_deg * kDeg,
+                    options_.blank_wall_rotation_fraction * turned);
 }
 
 OrientationEstimate OrientationFilter::predict(const Eigen::Matrix3d& R1,
                                                const Eigen::Matrix3d& P1,
                                                const PairRotation& pair) const {
   OrientationEstimate e;
-  predict(R1, P1, pair, 0.0, &e.R_world_from_camera, &e.covariance);
+  e.R_world_from_camera = R1;
+  e.covariance = P1;
+  if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
+  e.location.joint = predict(R1, P1, pair, 0.0, &e.R_world_from_camera, &e.covariance);
+  e.location.has_joint = true;
+  for (const MapDirection& d : map_.directions()) e.location.directions.push_back(d.direction);
   return e;
 }
 
@@ -65,12 +79,8 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   e.covariance = P1;
   if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
   e.blank_wall = pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
-  double extra = 0.0;
-  if (e.blank_wall) {
-    const double turned = Eigen::AngleAxisd(nearest_rotation(pair.R)).angle();
-    extra = std::hypot(options_.blank_wall_sigma_deg * kDeg,
-                       options_.blank_wall_rotation_fraction * turned);
-  }
+  const double extra = e.blank_wall ? blank_wall_sigma(pair.R) : 0.0;
+  e.blank_wall_sigma_rad = extra;
   PairRotation coasted;
   const bool coast = e.blank_wall && options_.coast_blank_walls && pair.has_last_motion;
   if (coast) {
@@ -78,7 +88,7 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
     coasted.R = pair.last_motion_R;
   }
   Eigen::Matrix3d predicted, P;
-  predict(R1, P1, coast ? coasted : pair, extra, &predicted, &P);
+  const JointOrientation joint = predict(R1, P1, coast ? coasted : pair, extra, &predicted, &P);
   if (!all_finite(predicted) || !all_finite(P)) return e;
   e.R_world_from_camera = predicted;
   e.covariance = P;
@@ -89,8 +99,15 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   for (size_t k = 0; k < pair.vps.size(); ++k)
     if (k >= pair.vp_accepted.size() || pair.vp_accepted[k])
       e.observations.push_back(pair.vps[k]);
-  e.location = map_.locate(e.R_world_from_camera, e.covariance, e.observations);
-  if (!options_.correct || !e.location.corrected) return e;
+  e.location = map_.locate(e.R_world_from_camera, joint, e.observations);
+  if (!options_.correct || !e.location.corrected) {
+    // The prediction is what the map takes; its pairings still count as sightings.
+    e.location.has_joint = true;
+    e.location.joint = joint;
+    e.location.directions.clear();
+    for (const MapDirection& d : map_.directions()) e.location.directions.push_back(d.direction);
+    return e;
+  }
   e.R_world_from_camera = e.location.R_world_from_camera;
   e.covariance = e.location.covariance;
   e.source = e.location.reacquired ? OrientationSource::kReacquired : OrientationSource::kMap;
@@ -114,9 +131,10 @@ bool OrientationFilter::judge(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& 
   // Those VPs, with the keyframe's pairs, locate the current camera while hardly trusting the
   // pair's rotation.
   Eigen::Matrix3d R_loose, P_loose;
-  predict(R1, P1, pair, std::max(extra_sigma_rad, options_.judge_sigma_deg * kDeg), &R_loose,
-          &P_loose);
-  const MapLocation judged = map_.locate_known(R_loose, P_loose, pair.vps, before.direction_id);
+  const JointOrientation loose =
+      predict(R1, P1, pair, std::max(extra_sigma_rad, options_.judge_sigma_deg * kDeg), &R_loose,
+              &P_loose);
+  const MapLocation judged = map_.locate_known(R_loose, loose, pair.vps, before.direction_id);
   if (!judged.pinned) return false;
   const Eigen::Matrix3d predicted = e->R_world_from_camera;
   const Eigen::AngleAxisd apart(judged.R_world_from_camera * predicted.transpose());

@@ -82,6 +82,13 @@ DirectionAssociation fit_directions(const Eigen::Matrix3d& R, const Eigen::Matri
                                     const std::vector<MapLandmark>& landmarks,
                                     const std::vector<int>& pairing);
 
+// An observed direction (odometry frame, unit) against a map direction (unit): the observation's
+// azimuthal equidistant coordinates in the direction's tangent plane (tangent_basis), either sign,
+// and their Jacobian with respect to a left rotation increment applied to the observation. False
+// beyond 90 degrees (not this direction).
+bool direction_residual(const Eigen::Vector3d& world, const Eigen::Vector3d& direction,
+                        Eigen::Vector2d* r, Eigen::Matrix<double, 2, 3>* H);
+
 // The 99 % quantile of the chi-square distribution with `dof` degrees of freedom.
 double chi2_quantile_99(int dof);
 

@@ -14,13 +14,21 @@
 #include "hybrid_vo/geometry/option_fields.h"
 #include "hybrid_vo/lines/direction_association.h"
 #include "hybrid_vo/lines/direction_structure.h"
+#include "hybrid_vo/lines/joint_orientation.h"
 
 namespace hybrid_vo {
 
 struct DirectionMapOptions {
   // Observations fused before a direction is confirmed and may correct the orientation: clutter
-  // rarely recurs in the same direction.
+  // rarely recurs in the same direction. And the frames (estimated pairs, each with parallax)
+  // between its first and its last observation: a direction is shown fixed over a baseline of
+  // motion, as a direction at infinity is and the converging lines of a near object are not.
   int confirm_hits = 3;
+  int confirm_frames = 5;
+  // How far a direction may drift per frame (degrees, per axis, a random walk): a scene's
+  // "directions" are not exactly fixed (a road bends, segments are not straight), and a map that
+  // held them rigid would hold the orientation to them.
+  double direction_drift_deg = 0.02;
   // An unconfirmed direction unseen for this many frames is forgotten; confirmed ones stay.
   int max_candidate_misses = 30;
   // The map's size; when full, the least supported direction makes room (candidates first).
@@ -33,7 +41,8 @@ struct DirectionMapOptions {
   // are two directions, not one.
   double min_separation_deg = 1.0;
   // A direction's sigma never drops below this (degrees): segments are not exactly straight, nor
-  // parallel in the scene, and thousands of fused frames must not make a direction rigid.
+  // parallel in the scene, and thousands of fused frames must not make a direction rigid. Kept
+  // as the direction's own noise, added to every observation of it.
   double min_direction_sigma_deg = 0.01;
   // An observation without a usable covariance gets this sigma; every one at least the floor.
   double default_sigma_deg = 1.0;
@@ -59,6 +68,7 @@ struct DirectionMapOptions {
 
 template <typename Visit>
 void visit_fields(DirectionMapOptions& o, Visit&& visit) {
+  HYBRID_VO_FIELDS(non_negative(), o.confirm_frames, o.direction_drift_deg);
   HYBRID_VO_FIELDS(positive(), o.confirm_hits, o.max_candidate_misses, o.max_directions,
                   o.max_orientation_sigma_deg, o.max_disagreements, o.default_sigma_deg,
                   o.wide_reacquisition_pairs);
@@ -73,7 +83,8 @@ struct MapDirection {
   int id = -1;  // stable, never reused
   // Unit, odometry frame, with the sign of its first observation (a direction has none).
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // rad^2, tangent plane of `direction`
+  // rad^2, tangent plane of `direction`: its marginal in the map's joint covariance.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int hits = 0;               // observations fused
   int created = 0;            // the frame it was created in
   int last_seen = -1;         // the frame of its last fused observation
@@ -97,6 +108,11 @@ struct MapLocation {
   bool reacquired = false;  // corrected by more than reacquisition_deg
   bool ambiguous = false;   // two associations explained the observations alike: no correction
   bool rejected = false;    // an association was found but failed the joint gate: no correction
+  // The joint state after this frame's correction (the prediction when nothing corrected it),
+  // and every map direction as corrected with it (the map's order): what update() commits.
+  bool has_joint = false;
+  JointOrientation joint;
+  std::vector<Eigen::Vector3d> directions;
 };
 
 struct DirectionMapStats {
@@ -106,11 +122,16 @@ struct DirectionMapStats {
   int created = 0, dropped = 0;
 };
 
-// Intended use per frame, with R and P the odometry's predicted orientation of the current
-// camera and its covariance (grown by the pair's rotation covariance):
-//   MapLocation where = map.locate(R, P, vps_seen_in_the_current_image);
+// Intended use per frame, with R the odometry's predicted orientation of the current camera and
+// `predicted` the joint state grown by the pair (prediction()):
+//   MapLocation where = map.locate(R, predicted, vps_seen_in_the_current_image);
 //   ... R = where.R_world_from_camera, P = where.covariance ...
 //   map.update(R, P, vps_seen_in_the_current_image, where);
+// The map holds the joint covariance of the orientation of the last frame it took and its
+// directions (joint_orientation.h): a correction updates the orientation and every
+// direction together, and the pair's prediction keeps their cross-covariances. The overloads
+// that take a bare covariance P of the orientation start from the map's joint state with the
+// orientation's covariance set to P (the cross-covariances shrunk if P is smaller).
 class DirectionMap {
  public:
   explicit DirectionMap(const DirectionMapOptions& options = {});
@@ -121,17 +142,31 @@ class DirectionMap {
   // (nothing paired, ambiguous, or failing the gate). Invalid R or P: unchanged, nothing paired.
   MapLocation locate(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                      const std::vector<VpObservation>& observations) const;
+  MapLocation locate(const Eigen::Matrix3d& R, const JointOrientation& predicted,
+                     const std::vector<VpObservation>& observations) const;
 
   // The same with the pairs known (observation i with the direction of id direction_ids[i], -1:
   // none), e.g. from the keyframe's view of the same VPs: the rotation fitted to them, no search.
   MapLocation locate_known(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                            const std::vector<VpObservation>& observations,
                            const std::vector<int>& direction_ids) const;
+  MapLocation locate_known(const Eigen::Matrix3d& R, const JointOrientation& predicted,
+                           const std::vector<VpObservation>& observations,
+                           const std::vector<int>& direction_ids) const;
 
-  // One frame: fuses the paired observations into their directions (under the located R, with
-  // its covariance P), counts disagreements, starts or confirms directions from the unpaired
-  // ones while P is certain, forgets stale candidates and directions that keep disagreeing, and
-  // re-tests the structure.
+  // The joint state of the last frame taken, its orientation's covariance set to P (see above);
+  // and that state moved by a pair: the orientation's covariance grown by Q (odometry frame),
+  // each direction's by its drift.
+  JointOrientation prediction(const Eigen::Matrix3d& P) const;
+  JointOrientation prediction(const Eigen::Matrix3d& P1, const Eigen::Matrix3d& Q) const;
+  const JointOrientation& joint() const { return joint_; }
+
+  // One frame: takes the location's joint state and corrected directions (the paired
+  // observations are in them already), fuses the unpaired observations into candidates (which
+  // move no orientation), counts disagreements, starts directions from the rest while P is
+  // certain, confirms, forgets stale candidates and directions that keep disagreeing, and
+  // re-tests the structure. A location without a joint state (default-constructed) takes
+  // prediction(P).
   void update(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
               const std::vector<VpObservation>& observations, const MapLocation& location);
 
@@ -162,16 +197,28 @@ class DirectionMap {
   bool spread(const DirectionAssociation& a, const std::vector<int>& confirmed) const;
   // Whether the map holds two confirmed directions that far apart.
   bool pinnable() const;
-  MapLocation locate_with(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
+  MapLocation locate_with(const Eigen::Matrix3d& R, const JointOrientation& predicted,
                           const std::vector<VpObservation>& observations,
                           const std::vector<int>* known_ids) const;
-  // Returns the index of the direction that made room for it, or -1.
-  int add_direction(const Eigen::Vector3d& world, const Eigen::Matrix3d& covariance);
-  void fuse(MapDirection* direction, const Eigen::Vector3d& world,
-            const Eigen::Matrix3d& covariance);
+  // The iterated joint update of the orientation and the directions by the pairs (observation k
+  // of `seen` with map direction index j); false when it fails or is implausible.
+  bool correct(const Eigen::Matrix3d& R, const std::vector<VpObservation>& seen,
+               const std::vector<std::pair<int, int>>& pairs, MapLocation* where) const;
+  // Moves direction j to `next`, its joint block re-expressed in the new tangent basis.
+  void move_direction(int j, const Eigen::Vector3d& next);
+  // Each direction's marginal covariance from the joint state.
+  void sync_covariances();
+  // A new direction observed at `world` (unit, odometry frame) from the camera at R, whose
+  // observation has covariance C (odometry frame, without the orientation's); returns the index
+  // of the direction that made room for it, or -1.
+  int add_direction(const Eigen::Vector3d& world, const Eigen::Matrix3d& C);
+  void remove_direction(int j);
+  // A candidate's observation: only its own direction takes the correction.
+  void fuse_candidate(int j, const Eigen::Vector3d& world, const Eigen::Matrix3d& C);
 
   DirectionMapOptions options_;
   std::vector<MapDirection> directions_;
+  JointOrientation joint_;  // [orientation of the last frame taken, directions_]
   DirectionStructure structure_;
   DirectionMapStats stats_;
   int next_id_ = 0;

@@ -97,6 +97,7 @@ struct OrientationEstimate {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
   OrientationSource source = OrientationSource::kPair;
   bool blank_wall = false;  // the pair's data could not fix the rotation
+  double blank_wall_sigma_rad = 0.0;  // then the uncertainty its rotation got (per axis)
   MapLocation location;     // of the pair's accepted VPs (or of every VP, when rejected)
   std::vector<VpObservation> observations;  // the VPs the map located the camera with
   double correction_deg = 0.0;  // from the pair's prediction
@@ -113,6 +114,8 @@ class OrientationFilter {
   // A non-finite pair rotation or covariance leaves the keyframe's.
   OrientationEstimate estimate(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
                                const PairRotation& pair) const;
+  // The uncertainty (rad, per axis) a blank wall's pair rotation R gets beyond its covariance.
+  double blank_wall_sigma(const Eigen::Matrix3d& R) const;
   // The pair's prediction alone, without the map: its rotation and its covariance grown by it.
   OrientationEstimate predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
                               const PairRotation& pair) const;
@@ -131,9 +134,10 @@ class OrientationFilter {
   void reset() { map_.reset(); }
 
  private:
-  // The pair's prediction of the current camera and its covariance.
-  void predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1, const PairRotation& pair,
-               double extra_sigma_rad, Eigen::Matrix3d* R, Eigen::Matrix3d* P) const;
+  // The pair's prediction of the current camera, its covariance and the joint state with the map.
+  JointOrientation predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
+                           const PairRotation& pair, double extra_sigma_rad, Eigen::Matrix3d* R,
+                           Eigen::Matrix3d* P) const;
 
   // The map's judgement of the pair (e holds its prediction): whether the pair's VPs that the
   // keyframe saw as two directions of the map, well apart, locate the current camera away from
