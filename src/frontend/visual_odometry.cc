@@ -104,6 +104,7 @@ bool VisualOdometry::begin_frame(Frame& f) {
   const VisualOdometryInput& input = f.input;
   VisualOdometryResult& r = f.result;
   r.R_wc = orientation_.R_wc();
+  r.orientation_covariance = orientation_.reported_covariance();
   r.centre = centre_;
   if (input.image.empty() || !input.camera.valid() || !std::isfinite(input.stamp)) {
     r.status = VoStatus::kInvalidInput;
@@ -146,10 +147,12 @@ void VisualOdometry::orient(Frame& f) {
 
 void VisualOdometry::integrate(Frame& f) {
   VisualOdometryResult& r = f.result;
-  orientation_.advance(f.oriented, f.input.stamp - keyframe_.stamp);
+  orientation_.advance(f.oriented, f.input.stamp - keyframe_.stamp,
+                       r.motion_covariance.topLeftCorner<3, 3>());
   // The current camera's centre in the keyframe is -R^T t.
   centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
   r.R_wc = orientation_.R_wc();
+  r.orientation_covariance = orientation_.reported_covariance();
   r.centre = centre_;
   r.status = VoStatus::kOk;
   r.message = "ok";

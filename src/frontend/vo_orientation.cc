@@ -47,6 +47,7 @@ OrientationFilterOptions filter_options(const VisualOdometryOptions& options) {
 
 VoOrientation::VoOrientation(const VisualOdometryOptions& options)
     : use_map_(options.use_vp_tracker),
+      rotation_calibration_sigma_(options.rotation_calibration_sigma),
       seed_sigma_px_(options.estimator.vp_detection.inlier_threshold_px / 3.0),
       seed_sigma_deg_(options.estimator.ransac.vp_threshold_deg / 3.0),
       filter_(filter_options(options)) {}
@@ -61,6 +62,12 @@ void VoOrientation::reset() {
   restart();
   R_wc_.setIdentity();
   covariance_.setZero();
+  sigma_sum_ = variance_sum_ = 0.0;
+}
+
+Eigen::Matrix3d VoOrientation::reported_covariance() const {
+  const double bound = std::max(0.0, sigma_sum_ * sigma_sum_ - variance_sum_);
+  return covariance_ + bound * Eigen::Matrix3d::Identity();
 }
 
 Eigen::Matrix3d VoOrientation::segment_motion(const PinholeCamera& camera, double dt) const {
@@ -93,7 +100,12 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
   const TwoViewMatches& m = *pair.matches;
   PairRotation rotation;
   rotation.R = est.pose.R;
-  if (est.covariance_valid) rotation.covariance = est.covariance.topLeftCorner<3, 3>();
+  // A pose whose curvature gave no covariance (its data do not fix it) is as uncertain as a
+  // blank wall's, not certain.
+  const double unknown = est.covariance_valid ? 0.0 : filter_.blank_wall_sigma(est.pose.R);
+  rotation.covariance = est.covariance_valid ? Eigen::Matrix3d(est.covariance.topLeftCorner<3, 3>())
+                                             : Eigen::Matrix3d(unknown * unknown *
+                                                               Eigen::Matrix3d::Identity());
   rotation.segment_matches = static_cast<int>(m.lines.size());
   rotation.vp_inliers = est.num_vp_inliers;
   if (pair.dt > 0.0) {
@@ -121,27 +133,47 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
   }
   o.R_wc = o.estimate.R_world_from_camera;
   o.covariance = o.estimate.covariance;
-  // A correction is the drift of earlier pairs, not this pair's motion: the translation stays as
-  // this pair's points fixed it (re-fitted under the anchored rotation, it was 37 -> 51 deg off
-  // on TUM fr3 structure_notexture). A rejected pair's rotation was wrong: its translation was
-  // fitted again under the map's (as every corrected pair's is with translation_given_rotation),
-  // and that pose also scales the motion.
-  if (o.estimate.source != OrientationSource::kPair)
+  // A correction is the drift of earlier pairs, not this pair's motion: the motion stays as this
+  // pair's points fixed it, rotation and translation (the translation re-fitted under the
+  // anchored rotation was 37 -> 51 deg off on TUM fr3 structure_notexture), and the map's share
+  // goes to the orientation only: the pairs keep the fast part, the map adds the slow one. A
+  // rejected pair's rotation was wrong: its translation was fitted again under the map's (as
+  // every corrected pair's is with translation_given_rotation), and that pose also scales the
+  // motion; a coasted pair moves by the last rate.
+  const OrientationSource source = o.estimate.source;
+  if (source == OrientationSource::kPairRejected || source == OrientationSource::kCoasted ||
+      o.estimate.refit.ok)
     o.pose.R = nearest_rotation(o.R_wc.transpose() * keyframe_R_wc);
   if (o.estimate.refit.ok) o.pose.t = o.estimate.refit.pose.t;
-  if (o.estimate.source == OrientationSource::kPairRejected) o.scale_pose = o.pose;
+  if (source == OrientationSource::kPairRejected) o.scale_pose = o.pose;
+  const double blank = std::hypot(o.estimate.blank_wall_sigma_rad, unknown);
+  const Eigen::AngleAxisd turned(o.pose.R);
+  const Eigen::Vector3d w = turned.angle() * turned.axis();
+  const double c = rotation_calibration_sigma_;
+  o.motion_rotation_extra = (blank * blank + c * c * w.squaredNorm()) * Eigen::Matrix3d::Identity();
   return o;
 }
 
-void VoOrientation::advance(const Oriented& oriented, double dt) {
+void VoOrientation::advance(const Oriented& oriented, double dt,
+                            const Eigen::Matrix3d& motion_rotation_covariance) {
   // A coasted pair keeps the last rate: its own rotation is what could not be trusted.
   if (dt > 0.0 && oriented.estimate.source != OrientationSource::kCoasted) {
     const Eigen::AngleAxisd turned(oriented.scale_pose.R);
     angular_velocity_ = turned.angle() * turned.axis() / dt;
   }
+  const double variance = std::max(0.0, motion_rotation_covariance.trace() / 3.0);
+  if (std::isfinite(variance)) {
+    sigma_sum_ += std::sqrt(variance);
+    variance_sum_ += variance;
+  }
+  // Two directions well apart measured the orientation against the scene: what the pairs before
+  // shared is no longer in it.
+  if (oriented.estimate.location.corrected && oriented.estimate.location.pinned)
+    sigma_sum_ = variance_sum_ = 0.0;
   R_wc_ = oriented.R_wc;
   covariance_ = oriented.covariance;
-  if (use_map_) filter_.update(oriented.estimate);
+  // Without the map too: the filter carries the rotation scale's share of the orientation.
+  filter_.update(oriented.estimate);
 }
 
 }  // namespace hybrid_vo

@@ -211,10 +211,16 @@ void VisualOdometry::fit_scale(Frame& f) {
     r.stages.scale_ms += ms_since(scale_start);
   }
   r.motion.t = pose.t * scale;
-  if (est.covariance_valid) {
-    r.motion_covariance = metric_motion_covariance(est.covariance, pose.t, scale, scale_sigma);
-    r.motion_covariance_valid = true;
-  }
+  // Without the estimator's covariance the rotation gets a blank wall's (VoOrientation::orient)
+  // and the translation's direction a radian: what its data could not fix.
+  Eigen::Matrix<double, 6, 6> unknown = Eigen::Matrix<double, 6, 6>::Zero();
+  const Eigen::Vector3d u = pose.t.normalized();
+  if (all_finite(u))
+    unknown.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() - u * u.transpose();
+  r.motion_covariance = metric_motion_covariance(est.covariance_valid ? est.covariance : unknown,
+                                                 pose.t, scale, scale_sigma);
+  r.motion_covariance.topLeftCorner<3, 3>() += f.oriented.motion_rotation_extra;
+  r.motion_covariance_valid = true;
 }
 
 }  // namespace hybrid_vo

@@ -70,6 +70,13 @@ struct VisualOdometryOptions {
   bool use_vp_tracker = true;
   bool anchor_orientation = true;
   OrientationFilterOptions orientation;
+  // How far every estimated rotation may be off as a whole, in its angle and in its axis (a
+  // fraction: a focal length, a camera's mounting, or a ground truth's own): the orientation's
+  // reported uncertainty grows by it times the angle turned, per axis
+  // (VoOrientation::reported_covariance). KITTI's excerpt turns 98 degrees and ends 1.0 degree
+  // off its ground truth: against every two-view estimate the truth turns 0.7 % more about axes
+  // tilted by 0.4 degrees (hybrid_vo_bench_frontend --direct-gap).
+  double rotation_calibration_sigma = 0.01;
 };
 
 // Its own fields, the KLT tracker's under klt_, the estimator's (with the VP detection in front)
@@ -85,6 +92,7 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   visit_fields(o.estimator, prefixed("estimator_", visit));
   HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches);
   visit("rotation_drift_floor_deg", o.orientation.drift_floor_deg, non_negative());
+  visit("rotation_calibration_sigma", o.rotation_calibration_sigma, non_negative());
   visit("coast_blank_walls", o.orientation.coast_blank_walls);
   visit("translation_given_rotation", o.orientation.translation_given_rotation);
   HYBRID_VO_FIELDS(positive(), o.mono_scale);
@@ -143,6 +151,8 @@ struct VisualOdometryResult {
   std::vector<StereoScaleObservation> scale_observations;
   double disparity_offset_px = 0.0;  // the offset applied (0 until self-calibration is sure)
   Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
+  // Of a left increment of R_wc, odometry frame (rad^2): VoOrientation::reported_covariance.
+  Eigen::Matrix3d orientation_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
   std::vector<int> vp_track_ids; // per VP match of the pair: the map direction of its prior, or -1

@@ -30,8 +30,15 @@ class VoOrientation {
   void reset();
 
   const Eigen::Matrix3d& R_wc() const { return R_wc_; }
-  // Of a left increment of R_wc in the odometry frame (rad^2).
+  // Of a left increment of R_wc in the odometry frame (rad^2): the filter's.
   const Eigen::Matrix3d& covariance() const { return covariance_; }
+  // What the orientation's uncertainty is, reported: the filter's, which takes the pairs' errors
+  // as independent (so that the map is not overruled by what a chain of pairs cannot know), with
+  // their sum bounded as if they were not. The pairs' errors correlate over time (rolling
+  // shutter, calibration, a ground truth's own; TUM's pairs share a bias of 0.14 degrees); for
+  // errors of sigma s_k whose correlation is unknown, the sum's sigma is at most sum s_k, not
+  // sqrt(sum s_k^2). Since the last frame whose orientation two map directions well apart fixed.
+  Eigen::Matrix3d reported_covariance() const;
   const DirectionMap& direction_map() const { return filter_.map(); }
 
   // How the camera turning on at its last rate for `dt` seconds moves the image: K R K^-1
@@ -52,6 +59,9 @@ class VoOrientation {
     Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
     OrientationEstimate estimate;  // how the map placed the camera
+    // What the motion's rotation covariance lacks beyond the estimator's (rad^2, camera):
+    // a blank wall's, and the calibration's share of the angle turned.
+    Eigen::Matrix3d motion_rotation_extra = Eigen::Matrix3d::Zero();
   };
   // The pair the orient stage needs to know of.
   struct Pair {
@@ -67,10 +77,15 @@ class VoOrientation {
                   const Pair& pair) const;
   // The pair accepted: its orientation becomes the odometry's, its rotation over `dt` seconds
   // (when positive; not a coasted one) the rotation rate, and the map takes the frame in.
-  void advance(const Oriented& oriented, double dt);
+  // `motion_rotation_covariance` is the motion's rotation covariance as published.
+  void advance(const Oriented& oriented, double dt,
+               const Eigen::Matrix3d& motion_rotation_covariance);
 
  private:
   const bool use_map_;
+  const double rotation_calibration_sigma_;
+  // Since the last pinned frame: the pairs' rotation sigmas (per axis) summed, and their squares.
+  double sigma_sum_ = 0.0, variance_sum_ = 0.0;
   // The first pair's VPs, as the map's seeds: the covariance of their fit at a third of the VP
   // detection's inlier threshold, plus a third of the estimator's VP threshold.
   const double seed_sigma_px_, seed_sigma_deg_;
