@@ -253,6 +253,15 @@ TEST(BenchFrontendCli, BadDirectGap) {
                  "--direct-gap: expected a number of frames >= 1");
 }
 
+TEST(BenchFrontendCli, BadTruthSigma) {
+  for (const char* option : {"--truth-rotation-sigma-deg", "--truth-direction-sigma-deg",
+                             "--truth-orientation-sigma-deg"})
+    for (const char* sigma : {"-1", "nan", "0.1deg"})
+      expect_error(run("hybrid_vo_bench_frontend",
+                       std::string("/no/sequence ") + option + " " + sigma),
+                   std::string(option) + ": expected a number of degrees >= 0");
+}
+
 TEST(EvalTrajectoryCli, MissingBag) {
   expect_error(run("hybrid_vo_eval_trajectory", "--bag /no/run.bag --gt /no/gt.bag"),
                "/no/run.bag");
