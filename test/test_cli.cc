@@ -253,6 +253,15 @@ TEST(BenchFrontendCli, BadDirectGap) {
                  "--direct-gap: expected a number of frames >= 1");
 }
 
+TEST(BenchFrontendCli, BadTruthSigma) {
+  for (const char* option : {"--truth-rotation-sigma-deg", "--truth-direction-sigma-deg",
+                             "--truth-orientation-sigma-deg"})
+    for (const char* sigma : {"-1", "nan", "0.1deg"})
+      expect_error(run("hybrid_vo_bench_frontend",
+                       std::string("/no/sequence ") + option + " " + sigma),
+                   std::string(option) + ": expected a number of degrees >= 0");
+}
+
 TEST(EvalTrajectoryCli, MissingBag) {
   expect_error(run("hybrid_vo_eval_trajectory", "--bag /no/run.bag --gt /no/gt.bag"),
                "/no/run.bag");
@@ -300,6 +309,13 @@ TEST(EvalTrajectoryCli, TumRotationMeasures) {
   EXPECT_NEAR(summary_value(o.output, "orient_last_deg"), 6.0, 1e-3) << o.output;
   EXPECT_NEAR(summary_value(o.output, "orient_max_deg"), 6.0, 1e-3) << o.output;
   EXPECT_NEAR(summary_value(o.output, "dir_deg"), 3.0, 1e-3) << o.output;
+  // TUM files carry no covariances: the NEES fields close the line, without a value.
+  for (const char* key : {"nees_rot_pair", "in95_rot_pair", "nees_orient", "in95_orient"})
+    EXPECT_TRUE(std::isnan(summary_value(o.output, key))) << key << ": " << o.output;
+  EXPECT_NE(o.output.find("dir_deg=3.000 nees_rot_pair=nan in95_rot_pair=nan nees_orient=nan "
+                          "in95_orient=nan\n"),
+            std::string::npos)
+      << o.output;
   // Windows of 0.6 s: 15 frames.
   const Outcome shorter =
       run("hybrid_vo_eval_trajectory", "--tum " + estimate + " " + truth + " --window 0.6");
@@ -310,6 +326,11 @@ TEST(EvalTrajectoryCli, TumRotationMeasures) {
     expect_error(run("hybrid_vo_eval_trajectory",
                      "--tum " + estimate + " " + truth + " --window " + bad),
                  "--window: expected a positive number of seconds");
+  for (const char* option : {"--truth-rotation-sigma-deg", "--truth-direction-sigma-deg",
+                             "--truth-orientation-sigma-deg"})
+    expect_error(run("hybrid_vo_eval_trajectory",
+                     "--tum " + estimate + " " + truth + " " + option + " -0.5"),
+                 std::string(option) + ": expected a number of degrees >= 0");
 }
 
 }  // namespace

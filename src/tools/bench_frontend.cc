@@ -17,13 +17,13 @@
 #include <thread>
 #include <vector>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "hybrid_vo/datasets/kitti.h"
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
+#include "hybrid_vo/evaluation/consistency.h"
 #include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/evaluation/trajectory.h"
 #include "hybrid_vo/frontend/frontend.h"
@@ -40,7 +40,8 @@ void usage(const char* program) {
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
                " [--drop-leaving] [--no-anchor] [--no-vp-tracker] [--seed S] [--opencv-threads N]"
-               " [--verbose]\n"
+               " [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
+               " [--truth-orientation-sigma-deg S] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
@@ -58,7 +59,13 @@ void usage(const char* program) {
                "  directly with frame i+G (SIFT, the pair tools' front end) and `5pc` estimates\n"
                "  their rotation; the odometry's chained rotation over the same G frames, and the\n"
                "  truth's, are compared with it. Where the truth is much further from these\n"
-               "  direct estimates than the odometry is, the drift against it is the truth's.\n";
+               "  direct estimates than the odometry is, the drift against it is the truth's.\n"
+               "  With ground truth, '# consistency:' lines: the NEES of each estimated pair's\n"
+               "  rotation and translation direction under the published motion covariance, and\n"
+               "  of the orientation against the first frame under the orientation's covariance,\n"
+               "  as hybrid_vo_eval_trajectory prints them; --truth-rotation-sigma-deg,\n"
+               "  --truth-direction-sigma-deg and --truth-orientation-sigma-deg add the truth's\n"
+               "  own noise (degrees per axis) as there.\n";
 }
 
 // The median of each coordinate.
@@ -145,6 +152,8 @@ int run(int argc, char** argv) {
   std::string trajectory_path;
   int direct_gap = 0;
   int opencv_threads = 1;
+  // The truth's own noise (radians per axis) for the NEES, as in hybrid_vo_eval_trajectory.
+  double truth_rotation_sigma = 0.0, truth_direction_sigma = 0.0, truth_orientation_sigma = 0.0;
   VisualOdometryOptions o;
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
@@ -180,6 +189,19 @@ int run(int argc, char** argv) {
       }
     }
     else if (a == "--opencv-threads" && i + 1 < argc) opencv_threads = std::atoi(argv[++i]);
+    else if ((a == "--truth-rotation-sigma-deg" || a == "--truth-direction-sigma-deg" ||
+              a == "--truth-orientation-sigma-deg") &&
+             i + 1 < argc) {
+      char* end = nullptr;
+      const double degrees = std::strtod(argv[++i], &end);
+      if (end == argv[i] || *end || !std::isfinite(degrees) || degrees < 0.0) {
+        std::cerr << a << ": expected a number of degrees >= 0, got '" << argv[i] << "'\n";
+        return 2;
+      }
+      (a == "--truth-rotation-sigma-deg"    ? truth_rotation_sigma
+       : a == "--truth-direction-sigma-deg" ? truth_direction_sigma
+                                            : truth_orientation_sigma) = degrees * M_PI / 180.0;
+    }
     else if (a == "--seed" && i + 1 < argc)
       o.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
@@ -248,7 +270,10 @@ int run(int argc, char** argv) {
     std::string ignored;
     datasets::read_kitti_poses(root + "/../poses/" + name + ".txt", &gt, &ignored);
   }
-  std::vector<double> pose_errors, rotation_nees;
+  std::vector<double> pose_errors;
+  // NEES of the estimated pairs (rotation, translation direction) and of the estimated frames'
+  // orientation against the first; NaN without a covariance.
+  std::vector<double> pair_rot_nees, pair_dir_nees, orientation_nees;
   // The rotation and translation direction errors of the estimated pairs (status OK), as
   // hybrid_vo_eval_trajectory takes them from the node's MotionEstimate messages.
   std::vector<double> pair_rot_deg, pair_dir_deg;
@@ -316,14 +341,21 @@ int run(int argc, char** argv) {
           pair_rot_deg.push_back(rotation_error(r.motion.R, truth_pose.R) * 180.0 / M_PI);
           pair_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
           error = std::max(pair_rot_deg.back(), pair_dir_deg.back());
-          // Whether the estimator's rotation covariance predicts its error: the normalised
-          // squared error, chi-square with 3 dof when it does.
-          if (r.estimate.estimate.covariance_valid) {
-            const Eigen::AngleAxisd aa(Eigen::Matrix3d(r.motion.R * truth_pose.R.transpose()));
-            const Eigen::Vector3d w = aa.angle() * aa.axis();
-            const Eigen::Matrix3d C = r.estimate.estimate.covariance.topLeftCorner<3, 3>();
-            rotation_nees.push_back(w.dot(C.ldlt().solve(w)));
-          }
+          // The motion and covariance the node publishes on ~relative_pose.
+          const Eigen::Matrix<double, 6, 6>& C = r.motion_covariance;
+          const bool valid = r.motion_covariance_valid;
+          pair_rot_nees.push_back(valid ? evaluation::rotation_nees(r.motion.R, truth_pose.R,
+                                                                    C.topLeftCorner<3, 3>(),
+                                                                    truth_rotation_sigma)
+                                        : NAN);
+          pair_dir_nees.push_back(valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
+                                                                     C.bottomRightCorner<3, 3>(),
+                                                                     truth_direction_sigma)
+                                        : NAN);
+          // r.orientation.covariance is that of r.R_wc (VoOrientation::advance takes both on).
+          orientation_nees.push_back(evaluation::orientation_nees(
+              odometry.front().R, r.R_wc, gt[0].R_wc, gt[i].R_wc, r.orientation.covariance,
+              truth_orientation_sigma));
         }
         pose_errors.push_back(error);
       }
@@ -501,9 +533,17 @@ int run(int argc, char** argv) {
                 median(pair_rot_deg), pair_rot_deg.size(), te.rot_window_median_deg, te.window_s,
                 te.rot_window_err_deg.size(), te.orientation_last_deg, te.orientation_max_deg,
                 median(pair_dir_deg));
-    if (!rotation_nees.empty())
-      std::printf("rotation NEES (3 if the covariance is right): median %.1f over %zu pairs\n",
-                  median(rotation_nees), rotation_nees.size());
+    auto consistency = [](const char* what, double truth_sigma, const std::vector<double>& nees,
+                          int dof, const char* items) {
+      std::printf("# consistency: %s (%d dof, truth sigma %g deg): %s\n", what, dof,
+                  truth_sigma * 180.0 / M_PI,
+                  evaluation::describe_nees(evaluation::summarize_nees(nees, dof), items).c_str());
+    };
+    consistency("rotation per pair", truth_rotation_sigma, pair_rot_nees, 3, "estimated pairs");
+    consistency("translation direction per pair", truth_direction_sigma, pair_dir_nees, 2,
+                "estimated pairs");
+    consistency("orientation against the first frame", truth_orientation_sigma, orientation_nees,
+                3, "estimated frames");
   }
   if (direct_gap > 0)
     print_direct_check(images, input.camera, odometry, truth, direct_gap,

@@ -12,10 +12,12 @@
 #include <Eigen/Geometry>
 #include <geometry_msgs/PoseStamped.h>
 #include <hybrid_vo/MotionEstimate.h>
+#include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include "hybrid_vo/evaluation/consistency.h"
 #include "hybrid_vo/evaluation/plot.h"
 #include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/evaluation/trajectory.h"
@@ -32,6 +34,8 @@ void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " --bag RUN.bag --gt GT.bag [--gt-topic /ground_truth/pose] [--plot OUT.png]"
                " [--window S]\n"
+               "         [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
+               " [--truth-orientation-sigma-deg S]\n"
                "       " << program << " --tum EST.txt GT.txt [--plot OUT.png] [--window S]\n"
                "  Per-pair rotation and translation-direction errors with AUC@5/10/20, RPE, ATE\n"
                "  after alignment (similarity without metric scale), KITTI-style drift, and a plot.\n"
@@ -39,9 +43,19 @@ void usage(const char* program) {
                "  consecutive poses), median over windows of S seconds (default 1), orientation\n"
                "  against the first frame at the last frame and at most; the median translation\n"
                "  direction error.\n"
+               "  From a bag, '# consistency:' lines: whether the reported covariances hold the\n"
+               "  errors (NEES, chi-square with 3 dof for rotations and 2 for directions when\n"
+               "  honest): per pair the rotation and the translation direction (~relative_pose's\n"
+               "  covariance), and the orientation against the first frame (~odometry's pose\n"
+               "  covariance). The truth's own noise, degrees per axis, is added to the\n"
+               "  covariance: --truth-rotation-sigma-deg to each pair's rotation,\n"
+               "  --truth-direction-sigma-deg to each pair's direction,\n"
+               "  --truth-orientation-sigma-deg to the orientation against the first frame\n"
+               "  (default 0 each).\n"
                "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n"
                "  rot_pair_deg=X rot_window_deg=X window_s=S orient_last_deg=X orient_max_deg=X\n"
-               "  dir_deg=X\n";
+               "  dir_deg=X nees_rot_pair=X in95_rot_pair=P nees_orient=X in95_orient=P\n"
+               "  (median NEES and percent inside the 95 % ellipsoid; nan without covariances)\n";
 }
 
 using evaluation::median;
@@ -56,11 +70,33 @@ StampedPose from_transform(double stamp, const geometry_msgs::Transform& t) {
   return p;
 }
 
+// A ~odometry message: the camera's pose in the odometry frame and the covariances as published.
+// The pose covariance needs no mapping to the camera: a left increment about the odom frame's
+// fixed axes is the same for every frame rigidly attached to the body.
+struct OdometrySample {
+  StampedPose camera;
+  nav_msgs::Odometry::_pose_type::_covariance_type pose_covariance;
+  bool twist_covariance = false;  // any non-zero entry
+};
+
+// The pose of a frame through its static transform to another, e.g. base_link -> camera.
+StampedPose through(StampedPose p, const geometry_msgs::Transform& link) {
+  const StampedPose l = from_transform(0.0, link);
+  p.c = p.c + p.R * l.c;
+  p.R = p.R * l.R;
+  return p;
+}
+
 struct Run {
   Trajectory trajectory;  // camera poses in the odometry frame
   std::vector<hybrid_vo::MotionEstimate> motions;
   int scale_known = 0;
+  std::vector<OdometrySample> odometry;
 };
+
+bool any_nonzero(const boost::array<double, 36>& values) {
+  return std::any_of(values.begin(), values.end(), [](double v) { return v != 0.0; });
+}
 
 bool read_run(const std::string& path, Run* run, std::string* error) {
   rosbag::Bag bag;
@@ -70,9 +106,11 @@ bool read_run(const std::string& path, Run* run, std::string* error) {
     *error = path + ": " + e.what();
     return false;
   }
-  // odom -> child poses over time, and static transforms (e.g. base_link -> camera).
+  // odom -> child poses over time, and static transforms (e.g. base_link -> camera), to the
+  // camera frame of the ~relative_pose messages.
   std::map<std::string, Trajectory> by_child;
   std::map<std::pair<std::string, std::string>, geometry_msgs::Transform> statics;
+  std::vector<nav_msgs::Odometry> odometry;
   for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
     if (const auto tf = m.instantiate<tf2_msgs::TFMessage>()) {
       for (const auto& t : tf->transforms) {
@@ -83,6 +121,8 @@ bool read_run(const std::string& path, Run* run, std::string* error) {
     } else if (const auto motion = m.instantiate<hybrid_vo::MotionEstimate>()) {
       run->motions.push_back(*motion);
       run->scale_known += motion->scale_known;
+    } else if (const auto o = m.instantiate<nav_msgs::Odometry>()) {
+      odometry.push_back(*o);
     }
   }
   bag.close();
@@ -90,27 +130,37 @@ bool read_run(const std::string& path, Run* run, std::string* error) {
     *error = path + ": no odom transforms and no hybrid_vo/MotionEstimate messages";
     return false;
   }
+  const std::string camera_frame = run->motions.empty() ? "" : run->motions.front().header.frame_id;
   if (!by_child.empty()) {
     // The longest odom -> child track; through a static child -> camera transform when one is
     // known, so that the poses are camera poses like the ground truth.
     auto best = by_child.begin();
     for (auto it = by_child.begin(); it != by_child.end(); ++it)
       if (it->second.size() > best->second.size()) best = it;
-    const std::string child = best->first;
-    std::string camera_frame;
-    if (!run->motions.empty()) camera_frame = run->motions.front().header.frame_id;
-    const auto link = statics.find({child, camera_frame});
-    for (StampedPose p : best->second) {
-      if (link != statics.end()) {
-        const StampedPose bc = from_transform(0.0, link->second);
-        p.c = p.c + p.R * bc.c;
-        p.R = p.R * bc.R;
-      }
-      run->trajectory.push_back(p);
-    }
+    const auto link = statics.find({best->first, camera_frame});
+    for (const StampedPose& p : best->second)
+      run->trajectory.push_back(link != statics.end() ? through(p, link->second) : p);
     std::sort(run->trajectory.begin(), run->trajectory.end(),
               [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
   }
+  for (const nav_msgs::Odometry& o : odometry) {
+    geometry_msgs::Transform pose;
+    pose.translation.x = o.pose.pose.position.x;
+    pose.translation.y = o.pose.pose.position.y;
+    pose.translation.z = o.pose.pose.position.z;
+    pose.rotation = o.pose.pose.orientation;
+    OdometrySample sample;
+    sample.camera = from_transform(o.header.stamp.toSec(), pose);
+    const auto link = statics.find({o.child_frame_id, camera_frame});
+    if (link != statics.end()) sample.camera = through(sample.camera, link->second);
+    sample.pose_covariance = o.pose.covariance;
+    sample.twist_covariance = any_nonzero(o.twist.covariance);
+    run->odometry.push_back(sample);
+  }
+  std::sort(run->odometry.begin(), run->odometry.end(),
+            [](const OdometrySample& a, const OdometrySample& b) {
+              return a.camera.stamp < b.camera.stamp;
+            });
   return true;
 }
 
@@ -165,11 +215,60 @@ void print_map_summary(const std::vector<hybrid_vo::MotionEstimate>& motions) {
               directions, estimated, held, reacquired, rejected, blank, coasted, overruled);
 }
 
+// One `# consistency:` line.
+void print_consistency(const char* what, double truth_sigma, const evaluation::NeesSummary& nees,
+                       const char* items, const std::string& more) {
+  std::printf("# consistency: %s (%d dof, truth sigma %g deg): %s%s\n", what, nees.dof,
+              truth_sigma * kDeg, evaluation::describe_nees(nees, items).c_str(), more.c_str());
+}
+
+// The orientation against the first frame from ~odometry's pose covariance (ROS order: x y z,
+// then the rotation), the first odometry pose with a true pose being the reference; and how
+// many messages carry a pose and a twist covariance at all.
+evaluation::NeesSummary orientation_consistency(const std::vector<OdometrySample>& odometry,
+                                                const Trajectory& gt, double tolerance,
+                                                double truth_sigma) {
+  const char* what = "orientation against the first frame";
+  if (odometry.empty()) {
+    std::printf("# consistency: %s: no nav_msgs/Odometry recorded\n", what);
+    return evaluation::summarize_nees({}, 3);
+  }
+  std::vector<double> nees;
+  int with_pose = 0, with_twist = 0;
+  const OdometrySample* first = nullptr;
+  StampedPose first_truth;
+  for (const OdometrySample& o : odometry) {
+    with_pose += any_nonzero(o.pose_covariance);
+    with_twist += o.twist_covariance;
+    StampedPose truth;
+    if (!evaluation::pose_at(gt, o.camera.stamp, tolerance, &truth)) continue;
+    if (!first) {
+      first = &o;
+      first_truth = truth;
+      continue;
+    }
+    nees.push_back(evaluation::orientation_nees(
+        first->camera.R, o.camera.R, first_truth.R, truth.R,
+        evaluation::covariance_block(o.pose_covariance.data(), 3), truth_sigma));
+  }
+  const evaluation::NeesSummary summary = evaluation::summarize_nees(nees, 3);
+  char more[160];
+  std::snprintf(more, sizeof(more),
+                "; %.1f %% of %zu odometry messages with a pose covariance, %.1f %% with a twist "
+                "covariance",
+                100.0 * with_pose / odometry.size(), odometry.size(),
+                100.0 * with_twist / odometry.size());
+  print_consistency(what, truth_sigma, summary, "poses", more);
+  return summary;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string bag, gt_bag, gt_topic = "/ground_truth/pose", tum_est, tum_gt, plot;
   double window_s = evaluation::kDefaultRotationWindowSeconds;
+  // The truth's own noise (radians per axis) for the NEES.
+  double truth_rotation_sigma = 0.0, truth_direction_sigma = 0.0, truth_orientation_sigma = 0.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -192,6 +291,19 @@ int main(int argc, char** argv) {
                   << "'\n";
         return 2;
       }
+    }
+    else if (a == "--truth-rotation-sigma-deg" || a == "--truth-direction-sigma-deg" ||
+             a == "--truth-orientation-sigma-deg") {
+      const std::string v = next();
+      char* end = nullptr;
+      const double degrees = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end || !std::isfinite(degrees) || degrees < 0.0) {
+        std::cerr << "error: " << a << ": expected a number of degrees >= 0, got '" << v << "'\n";
+        return 2;
+      }
+      (a == "--truth-rotation-sigma-deg"    ? truth_rotation_sigma
+       : a == "--truth-direction-sigma-deg" ? truth_direction_sigma
+                                            : truth_orientation_sigma) = degrees / kDeg;
     }
     else if (a == "--tum") {
       tum_est = next();
@@ -233,6 +345,8 @@ int main(int argc, char** argv) {
   // With a metric scale, the ratio of the estimated to the true translation length per pair: a
   // scale bias shows at a glance, not only through the drift.
   std::vector<double> scale_ratios;
+  // NEES of the estimated pairs' rotation and translation direction; NaN without a covariance.
+  std::vector<double> pair_rot_nees, pair_dir_nees;
   std::printf("pair,stamp_ref,stamp,status,rot_err_deg,dir_err_deg,scale_ratio\n");
   if (!run.motions.empty()) {
     for (const hybrid_vo::MotionEstimate& m : run.motions) {
@@ -256,6 +370,10 @@ int main(int argc, char** argv) {
         dir = hybrid_vo::translation_error(t, t_gt) * kDeg;
         pair_rot.push_back(rot);
         pair_dir.push_back(dir);
+        pair_rot_nees.push_back(evaluation::rotation_nees(
+            R, R_gt, evaluation::covariance_block(m.covariance.data(), 0), truth_rotation_sigma));
+        pair_dir_nees.push_back(evaluation::direction_nees(
+            t, t_gt, evaluation::covariance_block(m.covariance.data(), 3), truth_direction_sigma));
         if (m.scale_known && t_gt.norm() > 1e-9) {
           ratio = t.norm() / t_gt.norm();
           scale_ratios.push_back(ratio);
@@ -315,6 +433,15 @@ int main(int argc, char** argv) {
                 "p90 %.4f) over %zu metric pairs\n",
                 median(scale_ratios), evaluation::percentile(scale_ratios, 0.1),
                 evaluation::percentile(scale_ratios, 0.9), scale_ratios.size());
+  // Whether the covariances hold the errors; not last: scripts/demo shows the last three lines.
+  evaluation::NeesSummary rot_nees, orient_nees;
+  if (!bag.empty()) {
+    rot_nees = evaluation::summarize_nees(pair_rot_nees, 3);
+    print_consistency("rotation per pair", truth_rotation_sigma, rot_nees, "estimated pairs", "");
+    print_consistency("translation direction per pair", truth_direction_sigma,
+                      evaluation::summarize_nees(pair_dir_nees, 2), "estimated pairs", "");
+    orient_nees = orientation_consistency(run.odometry, gt, tolerance, truth_orientation_sigma);
+  }
   // Processing time per frame as the node measured it (MotionEstimate), skipped frames included:
   // what bounds the frame rate through the node. Then where it goes, stage by stage (the stages
   // overlap: the segments and the stereo matching run on a second thread), and the matches.
@@ -376,10 +503,12 @@ int main(int argc, char** argv) {
               te.orientation_last_deg, te.orientation_max_deg, dir);
   std::printf("summary: pairs=%zu auc5=%.2f auc10=%.2f auc20=%.2f rpe_trans=%.4f rpe_rot_deg=%.4f "
               "ate=%.4f rot_pair_deg=%.4f rot_window_deg=%.4f window_s=%g orient_last_deg=%.4f "
-              "orient_max_deg=%.4f dir_deg=%.3f\n",
+              "orient_max_deg=%.4f dir_deg=%.3f nees_rot_pair=%.3f in95_rot_pair=%.1f "
+              "nees_orient=%.3f in95_orient=%.1f\n",
               errors.size(), 100.0 * hybrid_vo::pose_auc(errors, 5.0),
               100.0 * hybrid_vo::pose_auc(errors, 10.0), 100.0 * hybrid_vo::pose_auc(errors, 20.0),
               te.rpe_trans, te.rpe_rot_deg, te.ate, rot_pair, te.rot_window_median_deg, window_s,
-              te.orientation_last_deg, te.orientation_max_deg, dir);
+              te.orientation_last_deg, te.orientation_max_deg, dir, rot_nees.median,
+              100.0 * rot_nees.inside95, orient_nees.median, 100.0 * orient_nees.inside95);
   return 0;
 }
