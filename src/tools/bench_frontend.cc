@@ -352,9 +352,9 @@ int run(int argc, char** argv) {
                                                                      C.bottomRightCorner<3, 3>(),
                                                                      truth_direction_sigma)
                                         : NAN);
-          // r.orientation.covariance is that of r.R_wc (VoOrientation::advance takes both on).
+          // The orientation's covariance as the node reports it (VoOrientation::reported_covariance).
           orientation_nees.push_back(evaluation::orientation_nees(
-              odometry.front().R, r.R_wc, gt[0].R_wc, gt[i].R_wc, r.orientation.covariance,
+              odometry.front().R, r.R_wc, gt[0].R_wc, gt[i].R_wc, r.orientation_covariance,
               truth_orientation_sigma));
         }
         pose_errors.push_back(error);
