@@ -166,10 +166,14 @@ void VoOrientation::advance(const Oriented& oriented, double dt,
     sigma_sum_ += std::sqrt(variance);
     variance_sum_ += variance;
   }
-  // Two directions well apart measured the orientation against the scene: what the pairs before
-  // shared is no longer in it.
-  if (oriented.estimate.location.corrected && oriented.estimate.location.pinned)
-    sigma_sum_ = variance_sum_ = 0.0;
+  // The map's correction shrank the filter's uncertainty by a share: the excess shrinks alike
+  // (sigma_sum^2 - variance_sum scales with it).
+  const double before = oriented.estimate.predicted_covariance.trace();
+  const double share = before > 0.0 ? oriented.covariance.trace() / before : 1.0;
+  if (std::isfinite(share) && share < 1.0) {
+    sigma_sum_ *= std::sqrt(std::max(0.0, share));
+    variance_sum_ *= std::max(0.0, share);
+  }
   R_wc_ = oriented.R_wc;
   covariance_ = oriented.covariance;
   // Without the map too: the filter carries the rotation scale's share of the orientation.

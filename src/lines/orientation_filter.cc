@@ -66,6 +66,7 @@ OrientationEstimate OrientationFilter::predict(const Eigen::Matrix3d& R1,
   e.covariance = P1;
   if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
   e.location.joint = predict(R1, P1, pair, 0.0, &e.R_world_from_camera, &e.covariance);
+  e.predicted_covariance = e.covariance;
   e.location.has_joint = true;
   for (const MapDirection& d : map_.directions()) e.location.directions.push_back(d.direction);
   return e;
@@ -91,7 +92,7 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   const JointOrientation joint = predict(R1, P1, coast ? coasted : pair, extra, &predicted, &P);
   if (!all_finite(predicted) || !all_finite(P)) return e;
   e.R_world_from_camera = predicted;
-  e.covariance = P;
+  e.covariance = e.predicted_covariance = P;
   if (coast) e.source = OrientationSource::kCoasted;
 
   if (options_.correct && judge(R1, P1, pair, extra, &e)) return e;

@@ -37,7 +37,8 @@ class VoOrientation {
   // their sum bounded as if they were not. The pairs' errors correlate over time (rolling
   // shutter, calibration, a ground truth's own; TUM's pairs share a bias of 0.14 degrees); for
   // errors of sigma s_k whose correlation is unknown, the sum's sigma is at most sum s_k, not
-  // sqrt(sum s_k^2). Since the last frame whose orientation two map directions well apart fixed.
+  // sqrt(sum s_k^2). A correction by the map takes the same share of that excess as of the
+  // filter's own uncertainty: strong directions remove it, weak ones leave it.
   Eigen::Matrix3d reported_covariance() const;
   const DirectionMap& direction_map() const { return filter_.map(); }
 
@@ -84,7 +85,7 @@ class VoOrientation {
  private:
   const bool use_map_;
   const double rotation_calibration_sigma_;
-  // Since the last pinned frame: the pairs' rotation sigmas (per axis) summed, and their squares.
+  // The pairs' rotation sigmas (per axis) summed, and their squares, as corrections left them.
   double sigma_sum_ = 0.0, variance_sum_ = 0.0;
   // The first pair's VPs, as the map's seeds: the covariance of their fit at a third of the VP
   // detection's inlier threshold, plus a third of the estimator's VP threshold.

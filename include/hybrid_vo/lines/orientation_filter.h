@@ -95,6 +95,7 @@ const char* to_string(OrientationSource source);
 struct OrientationEstimate {
   Eigen::Matrix3d R_world_from_camera = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
+  Eigen::Matrix3d predicted_covariance = Eigen::Matrix3d::Zero();  // before the map's correction
   OrientationSource source = OrientationSource::kPair;
   bool blank_wall = false;  // the pair's data could not fix the rotation
   double blank_wall_sigma_rad = 0.0;  // then the uncertainty its rotation got (per axis)
