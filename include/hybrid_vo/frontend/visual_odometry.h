@@ -18,6 +18,7 @@
 #include "hybrid_vo/frontend/stereo.h"
 #include "hybrid_vo/frontend/vo_orientation.h"
 #include "hybrid_vo/frontend/worker_thread.h"
+#include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/lines/two_view.h"
 
 namespace hybrid_vo {
@@ -144,6 +145,14 @@ struct VisualOdometryResult {
   double disparity_offset_px = 0.0;  // the offset applied (0 until self-calibration is sure)
   Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
+  // Of this pose (R_wc, centre), [position, rotation as a left increment of R_wc] in the odometry
+  // frame (ROS's order, geometry/pose_covariance.h): the rotation block is the orientation's
+  // (orientation.covariance, as the map holds it); the position is chained over the integrated
+  // pairs to first order, with its cross terms. Without a metric scale the position is in units
+  // of mono_scale per pair and knows nothing of the scale's drift. Zero at the first frame (and
+  // after a reset); a restart keeps it, as it keeps the pose.
+  Matrix6d pose_covariance = Matrix6d::Zero();
+  int pose_covariance_gaps = 0;  // integrated pairs without a usable covariance, ever
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
   std::vector<int> vp_track_ids; // per VP match of the pair: the map direction of its prior, or -1
   // How the map of directions placed this frame (with use_vp_tracker): the orientation's source,
@@ -204,6 +213,7 @@ class VisualOdometry {
     Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d R_wc_covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    Matrix6d pose_covariance = Matrix6d::Zero();
   };
 
   // The stereo matching of features by id (the searches are left to the caller).
@@ -295,6 +305,7 @@ class VisualOdometry {
   DisparityOffsetFilter offset_filter_;
   Keyframe keyframe_;
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  PoseCovarianceChain pose_covariance_;
   double last_stamp_ = -1e300;
 };
 
