@@ -68,7 +68,7 @@ struct VisualOdometryOptions {
   // per axis): it tells a pair whose points barely separate rotation from translation (white
   // panels seen from 2 m: 0.08 deg) from a well conditioned one (KITTI: 0.003 deg), where VPs,
   // with their tenths of a degree of noise, must not move it.
-  bool use_vp_tracker = true;
+  bool use_direction_map = true;
   bool anchor_orientation = true;
   OrientationFilterOptions orientation;
 };
@@ -79,7 +79,7 @@ struct VisualOdometryOptions {
 template <typename Visit>
 void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(any_value(), o.use_lines, o.track_lines, o.concurrent,
-                  o.stereo_current_disparity, o.stereo_refine_tracks, o.use_vp_tracker,
+                  o.stereo_current_disparity, o.stereo_refine_tracks, o.use_direction_map,
                   o.anchor_orientation);
   visit("max_features", o.features.points.max_features, positive());
   visit_fields(o.klt, prefixed("klt_", visit));
@@ -155,7 +155,7 @@ struct VisualOdometryResult {
   int pose_covariance_gaps = 0;  // integrated pairs without a usable covariance, ever
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
   std::vector<int> vp_track_ids; // per VP match of the pair: the map direction of its prior, or -1
-  // How the map of directions placed this frame (with use_vp_tracker): the orientation's source,
+  // How the map of directions placed this frame (with use_direction_map): the orientation's source,
   // the directions each VP was paired with, blank wall, correction.
   OrientationEstimate orientation;
   int num_point_matches = 0, num_line_matches = 0;
