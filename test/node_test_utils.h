@@ -17,6 +17,7 @@
 #include <hybrid_vo/FeaturePoints.h>
 #include <hybrid_vo/MotionEstimate.h>
 #include <hybrid_vo/VanishingPoints.h>
+#include <nav_msgs/Odometry.h>
 #include <opencv2/core.hpp>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -73,6 +74,7 @@ class NodeHarness {
     motion_sub_ = nh.subscribe("hybrid_vo/relative_pose", 100, &NodeHarness::on_motion, this);
     diagnostics_sub_ = nh.subscribe("/diagnostics", 100, &NodeHarness::on_diagnostics, this);
     vps_sub_ = nh.subscribe("hybrid_vo/vanishing_points", 100, &NodeHarness::on_vps, this);
+    odometry_sub_ = nh.subscribe("hybrid_vo/odometry", 100, &NodeHarness::on_odometry, this);
   }
 
   // Waits until the node takes the left camera's topics (and `also`) and the harness hears the
@@ -80,7 +82,7 @@ class NodeHarness {
   ::testing::AssertionResult wait_for_node(const std::vector<ros::Publisher>& also = {}) {
     std::vector<std::pair<ros::Publisher, uint32_t>> inputs = {{left_, 1}, {left_info_, 1}};
     for (const ros::Publisher& p : also) inputs.emplace_back(p, 1);
-    return wait_connected(inputs, {motion_sub_, diagnostics_sub_, vps_sub_});
+    return wait_connected(inputs, {motion_sub_, diagnostics_sub_, vps_sub_, odometry_sub_});
   }
 
   // Waits for the ~relative_pose message of `stamp`.
@@ -114,8 +116,10 @@ class NodeHarness {
 
   ros::Publisher left_, left_info_, right_, right_info_, points_, lines_;
   void on_vps(const VanishingPoints::ConstPtr& v) { last_vps_ = *v; }
+  void on_odometry(const nav_msgs::Odometry::ConstPtr& o) { odometry_[o->header.stamp] = *o; }
 
-  ros::Subscriber motion_sub_, diagnostics_sub_, vps_sub_;
+  ros::Subscriber motion_sub_, diagnostics_sub_, vps_sub_, odometry_sub_;
+  std::map<ros::Time, nav_msgs::Odometry> odometry_;  // the last ~odometry per stamp
   VanishingPoints last_vps_;  // the last ~vanishing_points
   std::map<ros::Time, MotionEstimate> motions_;  // the last answer per stamp
   std::vector<MotionEstimate> received_;          // every answer, in arrival order
@@ -138,6 +142,16 @@ inline void publish_static_camera(NodeHarness* h) {
   t.transform.rotation.y = q.y();
   t.transform.rotation.z = q.z();
   h->static_broadcaster_.sendTransform(t);
+}
+
+// nav_msgs/Odometry's covariance arrays as matrices; a lost track's (9999 on the diagonal).
+inline Eigen::Matrix<double, 6, 6> covariance_of(const boost::array<double, 36>& a) {
+  Eigen::Matrix<double, 6, 6> C;
+  for (int i = 0; i < 36; ++i) C(i / 6, i % 6) = a[i];
+  return C;
+}
+inline bool unknown(const boost::array<double, 36>& a) {
+  return covariance_of(a) == 9999.0 * Eigen::Matrix<double, 6, 6>::Identity();
 }
 
 inline double diagnostic_value(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {

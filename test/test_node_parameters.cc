@@ -94,7 +94,7 @@ std::vector<Case> every_parameter() {
        [](P p) { return p.odometry.estimator.vp_detection.inlier_threshold_px == 1.0; }},
       {"vp_min_inliers", 15,
        [](P p) { return p.odometry.estimator.vp_detection.min_inliers == 15; }},
-      {"vp_tracker", false, [](P p) { return !p.odometry.use_vp_tracker; }},
+      {"direction_map", false, [](P p) { return !p.odometry.use_direction_map; }},
       {"anchor_orientation", false, [](P p) { return !p.odometry.anchor_orientation; }},
       {"coast_blank_walls", true, [](P p) { return p.odometry.orientation.coast_blank_walls; }},
       {"translation_given_rotation", true,
@@ -198,6 +198,32 @@ TEST(NodeParameters, BadValuesAndUnknownNamesAreReportedAndKeepTheDefault) {
   EXPECT_EQ(read_one("mono_scale", 2, &warnings).odometry.mono_scale, 2.0);
   EXPECT_EQ(read_one("max_features", 499.6, &warnings).odometry.features.points.max_features, 500);
   EXPECT_TRUE(warnings.empty());
+}
+
+// A renamed parameter's old name still takes effect, with a warning that names the new one (the
+// node logs each warning once, at start-up); beside the new name it is ignored.
+TEST(NodeParameters, OldNamesStillWorkAndWarn) {
+  std::vector<std::string> warnings;
+  const NodeParameters p = read_one("vp_tracker", false, &warnings);
+  EXPECT_FALSE(p.odometry.use_direction_map);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], "vp_tracker: deprecated, use direction_map (taken as direction_map)");
+  XmlRpcValue both;
+  both["vp_tracker"] = false;
+  both["direction_map"] = true;
+  warnings.clear();
+  EXPECT_TRUE(read_node_parameters(both, &warnings).odometry.use_direction_map);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("ignored"), std::string::npos) << warnings[0];
+  // A bad value under the old name is named under it.
+  warnings.clear();
+  EXPECT_TRUE(read_one("vp_tracker", "no", &warnings).odometry.use_direction_map);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_EQ(warnings[1], "vp_tracker: expected a boolean; keeping the default");
+  // No config file uses it any more.
+  for (const char* config : {"default", "kitti", "lamar", "low_texture"})
+    EXPECT_EQ(yaml_keys(std::string("config/") + config + ".yaml").count("vp_tracker"), 0u)
+        << config;
 }
 
 TEST(OptionFields, ValidateNamesTheFirstFieldOutOfBounds) {

@@ -3,6 +3,7 @@
 // the scenario with --gtest_filter.
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <random>
 #include <string>
@@ -15,6 +16,7 @@
 #include <hybrid_vo/FeatureLines.h>
 #include <hybrid_vo/FeaturePoints.h>
 #include <hybrid_vo/MotionEstimate.h>
+#include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -23,6 +25,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/render/sequence.h"
 #include "node_test_utils.h"
@@ -30,11 +33,13 @@
 namespace hybrid_vo {
 namespace {
 
+using testing::covariance_of;
 using testing::diagnostic_value;
 using testing::image_of;
 using testing::info_of;
 using testing::NodeHarness;
 using testing::publish_static_camera;
+using testing::unknown;
 
 constexpr double kDeg = 180.0 / M_PI;
 
@@ -50,6 +55,59 @@ Eigen::Isometry3d gt_odom_base(const render::Sequence& seq, int first, int frame
     return w_cam * base_cam.inverse();
   };
   return base(first).inverse() * base(frame);
+}
+
+Eigen::Isometry3d pose_of(const nav_msgs::Odometry& o) {
+  const auto& p = o.pose.pose;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y,
+                                  p.orientation.z).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
+  return T;
+}
+
+Eigen::Vector3d vector_of(const geometry_msgs::Vector3& v) { return {v.x, v.y, v.z}; }
+
+// ~odometry of a run without faults, as an EKF takes it: every pose and twist covariance a
+// covariance, non-zero in at least 95 % of the messages (all but the first frame's), the
+// position's growing along the path; the twist the motion between the two poses it joins, in the
+// child frame.
+void expect_honest_odometry(NodeHarness& h) {
+  int both = 0, twists_checked = 0;
+  const nav_msgs::Odometry* previous = nullptr;
+  for (const auto& [stamp, o] : h.odometry_) {
+    const Matrix6d pose = covariance_of(o.pose.covariance);
+    const Matrix6d twist = covariance_of(o.twist.covariance);
+    EXPECT_TRUE(is_covariance(pose)) << stamp << "\n" << pose;
+    EXPECT_TRUE(is_covariance(twist)) << stamp << "\n" << twist;
+    EXPECT_FALSE(unknown(o.pose.covariance)) << stamp << ": lost without a fault";
+    both += pose.norm() > 0.0 && twist.norm() > 0.0 && !unknown(o.twist.covariance);
+    if (previous && !unknown(o.twist.covariance) && h.motions_.count(stamp) &&
+        h.motions_[stamp].reference_stamp == previous->header.stamp) {
+      const double dt = (stamp - previous->header.stamp).toSec();
+      const Eigen::Isometry3d a = pose_of(*previous), b = pose_of(o);
+      const Eigen::AngleAxisd turned(a.rotation().transpose() * b.rotation());
+      const Eigen::Vector3d linear = b.rotation().transpose() * (b.translation() - a.translation());
+      EXPECT_LT((vector_of(o.twist.twist.angular) * dt - turned.angle() * turned.axis()).norm(),
+                1e-5) << stamp;
+      EXPECT_LT((vector_of(o.twist.twist.linear) * dt - linear).norm(), 1e-5) << stamp;
+      ++twists_checked;
+    }
+    previous = &o;
+  }
+  ASSERT_GE(h.odometry_.size(), 10u);
+  EXPECT_GE(both, 0.95 * h.odometry_.size()) << "of " << h.odometry_.size();
+  EXPECT_GE(twists_checked, static_cast<int>(h.odometry_.size()) / 2);
+  const Matrix6d first = covariance_of(std::next(h.odometry_.begin())->second.pose.covariance);
+  const Matrix6d last = covariance_of(h.odometry_.rbegin()->second.pose.covariance);
+  const double first_variance = first.topLeftCorner<3, 3>().trace();
+  const double last_variance = last.topLeftCorner<3, 3>().trace();
+  EXPECT_GT(last_variance, first_variance);
+  ::testing::Test::RecordProperty(
+      "odometry_with_covariances",
+      std::to_string(both) + " of " + std::to_string(h.odometry_.size()));
+  ::testing::Test::RecordProperty("final_position_sigma_m",
+                                  std::to_string(std::sqrt(last_variance)));
 }
 
 TEST(Replay, RenderedStereoSequence) {
@@ -103,6 +161,7 @@ TEST(Replay, RenderedStereoSequence) {
   RecordProperty("path_m", std::to_string(path));
   EXPECT_EQ(h.last_odometry_status_.level, diagnostic_msgs::DiagnosticStatus::OK)
       << h.last_odometry_status_.message;
+  expect_honest_odometry(h);
 
   // The map of world directions: every direction reports its uncertainty and its disagreements;
   // the corridor's Manhattan directions are held to a fraction of a degree, form a tested triad,

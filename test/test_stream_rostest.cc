@@ -13,17 +13,20 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/render/sequence.h"
 #include "node_test_utils.h"
 
 namespace hybrid_vo {
 namespace {
 
+using testing::covariance_of;
 using testing::diagnostic_value;
 using testing::image_of;
 using testing::info_of;
 using testing::NodeHarness;
 using testing::publish_static_camera;
+using testing::unknown;
 
 const char kFrame[] = "camera_left_optical";
 
@@ -136,6 +139,12 @@ TEST(Faults, EachFaultIsCountedAndRecoveredFrom) {
     const double after = run.counter(fault.counter);
     EXPECT_EQ(h.last_odometry_status_.level, diagnostic_msgs::DiagnosticStatus::OK)
         << h.last_odometry_status_.message;
+    if (fault.restarts) {
+      // The pose after the fault is published as lost: its covariances say "unknown".
+      const auto lost = h.odometry_.find(h.received_.at(fault.first_answer).header.stamp);
+      EXPECT_TRUE(lost != h.odometry_.end() && unknown(lost->second.pose.covariance) &&
+                  unknown(lost->second.twist.covariance));
+    }
     faults.push_back(fault);
     return after - before;
   };
@@ -254,6 +263,14 @@ TEST(Faults, EachFaultIsCountedAndRecoveredFrom) {
                           << " pairs with " << m.reference_stamp << ", before the fault";
     }
   }
+  // Every other pose carries a covariance, known once the chain has moved.
+  int known = 0;
+  for (const auto& [stamp, o] : h.odometry_) {
+    EXPECT_TRUE(is_covariance(covariance_of(o.pose.covariance))) << stamp;
+    EXPECT_TRUE(is_covariance(covariance_of(o.twist.covariance))) << stamp;
+    known += !unknown(o.pose.covariance) && !unknown(o.twist.covariance);
+  }
+  EXPECT_GE(known, static_cast<int>(h.odometry_.size()) - 3 * static_cast<int>(faults.size()));
   // Frames are paired in order everywhere.
   for (const MotionEstimate& m : h.received_) {
     if (m.status == MotionEstimate::STATUS_OK) {

@@ -25,6 +25,7 @@
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/frontend/worker_thread.h"
 #include "hybrid_vo/geometry/homogeneous.h"
+#include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/render/renderer.h"
 #include "hybrid_vo/render/sequence.h"
 #include "image_test_utils.h"
@@ -117,6 +118,7 @@ void expect_same_odometry(VisualOdometry& a, const std::vector<VisualOdometryInp
     EXPECT_EQ(ra.motion.t, rb.motion.t) << "frame " << i;
     EXPECT_EQ(ra.R_wc, rb.R_wc) << "frame " << i;
     EXPECT_EQ(ra.centre, rb.centre) << "frame " << i;
+    EXPECT_EQ(ra.pose_covariance, rb.pose_covariance) << "frame " << i;
     EXPECT_EQ(ra.scale_known, rb.scale_known) << "frame " << i;
     EXPECT_EQ(ra.scale_observations.size(), rb.scale_observations.size()) << "frame " << i;
     estimated += ra.status == VoStatus::kOk;
@@ -165,6 +167,80 @@ TEST_F(VideoFrontEnd, ColourFramesGiveTheGreyFramesOdometry) {
   }
   VisualOdometry a, b;
   expect_same_odometry(a, colour, b, grey);
+}
+
+// The pose's covariance (geometry/pose_covariance.h has its maths against Monte-Carlo): a
+// covariance in every frame, the orientation block at least the map's, the position growing along
+// the chain and in mono in units of mono_scale; a restart keeps it with the pose, a reset (or time
+// going backwards) zeroes it with the pose.
+TEST_F(VideoFrontEnd, PoseCovarianceAccumulatesAndFollowsThePose) {
+  auto position = [](const VisualOdometryResult& r) {
+    return r.pose_covariance.topLeftCorner<3, 3>().trace();
+  };
+  VisualOdometry vo;
+  VisualOdometryResult r;
+  double first_position = 0.0;
+  int estimated = 0, without_covariance = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    r = vo.process(input(i, true));
+    SCOPED_TRACE("frame " + std::to_string(i));
+    EXPECT_TRUE(is_covariance(r.pose_covariance));
+    if (i == 0) {
+      EXPECT_EQ(r.pose_covariance, Matrix6d::Zero());  // the origin is exact
+    }
+    if (r.status != VoStatus::kOk) continue;
+    ++estimated;
+    without_covariance += !r.motion_covariance_valid;
+    // At least the map's: the reported one bounds the pairs' correlated errors beside it.
+    const Eigen::Matrix3d beyond =
+        r.pose_covariance.bottomRightCorner<3, 3>() - r.orientation.covariance;
+    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(0.5 * (beyond + beyond.transpose()))
+                  .eigenvalues()
+                  .minCoeff(),
+              -1e-12 * r.orientation.covariance.norm());
+    EXPECT_GT(position(r), 0.0);
+    if (first_position == 0.0) first_position = position(r);
+  }
+  EXPECT_GE(estimated, kFrames / 2);
+  EXPECT_EQ(r.pose_covariance_gaps, without_covariance);
+  EXPECT_GT(position(r), 2.0 * first_position);
+
+  // A restart keeps the pose and its covariance; a reset returns both to the exact origin, and
+  // so does time going backwards.
+  const VisualOdometryResult before = r;
+  vo.restart();
+  r = vo.process(input(kFrames - 1, true));
+  EXPECT_EQ(r.status, VoStatus::kFirstFrame);
+  EXPECT_EQ(r.centre, before.centre);
+  EXPECT_EQ(r.pose_covariance, before.pose_covariance);
+  vo.reset();
+  r = vo.process(input(0, true));
+  EXPECT_EQ(r.pose_covariance, Matrix6d::Zero());
+  r = vo.process(input(1, true));
+  ASSERT_EQ(r.status, VoStatus::kOk);
+  EXPECT_GT(position(r), 0.0);
+  r = vo.process(input(0, true));
+  EXPECT_EQ(r.status, VoStatus::kReset);
+  EXPECT_EQ(r.centre, Eigen::Vector3d::Zero());
+  EXPECT_EQ(r.pose_covariance, Matrix6d::Zero());
+
+  // Mono: the same poses at twice the mono_scale have twice the position's standard deviation.
+  VisualOdometryOptions doubled;
+  doubled.mono_scale = 2.0;
+  VisualOdometry unit_vo, doubled_vo(doubled);
+  int compared = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    const VisualOdometryResult a = unit_vo.process(input(i, false));
+    const VisualOdometryResult b = doubled_vo.process(input(i, false));
+    ASSERT_EQ(a.status, b.status);
+    if (a.status != VoStatus::kOk) continue;
+    ++compared;
+    EXPECT_NEAR(position(b), 4.0 * position(a), 1e-6 * position(b)) << "frame " << i;
+    EXPECT_LT((a.pose_covariance.bottomRightCorner<3, 3>() -
+               b.pose_covariance.bottomRightCorner<3, 3>()).norm(),
+              1e-9 * a.pose_covariance.norm());
+  }
+  EXPECT_GE(compared, kFrames / 2);
 }
 
 // Distance in pixels from the rendered ground truth: a keyframe segment's endpoints carried into

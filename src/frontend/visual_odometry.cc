@@ -53,6 +53,7 @@ void VisualOdometry::reset() {
   restart();
   orientation_.reset();
   centre_.setZero();
+  pose_covariance_.reset();
   last_stamp_ = -1e300;
 }
 
@@ -103,9 +104,13 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
 bool VisualOdometry::begin_frame(Frame& f) {
   const VisualOdometryInput& input = f.input;
   VisualOdometryResult& r = f.result;
-  r.R_wc = orientation_.R_wc();
-  r.orientation_covariance = orientation_.reported_covariance();
-  r.centre = centre_;
+  const auto report_pose = [&] {
+    r.R_wc = orientation_.R_wc();
+    r.centre = centre_;
+    r.pose_covariance = pose_covariance_.covariance();
+    r.pose_covariance_gaps = pose_covariance_.gaps();
+  };
+  report_pose();
   if (input.image.empty() || !input.camera.valid() || !std::isfinite(input.stamp)) {
     r.status = VoStatus::kInvalidInput;
     r.message = input.image.empty() ? "empty image" : "invalid camera or stamp";
@@ -114,6 +119,7 @@ bool VisualOdometry::begin_frame(Frame& f) {
   if (input.stamp < last_stamp_) {
     reset();
     f.was_reset = true;
+    report_pose();  // the origin again
   }
   // The segments move as the camera turns at its last rate; beyond that, by their own motion.
   if (keyframe_.valid && input.stamp > last_stamp_)
@@ -152,8 +158,12 @@ void VisualOdometry::integrate(Frame& f) {
   // The current camera's centre in the keyframe is -R^T t.
   centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
   r.R_wc = orientation_.R_wc();
-  r.orientation_covariance = orientation_.reported_covariance();
   r.centre = centre_;
+  pose_covariance_.integrate(keyframe_.pose_covariance, r.R_wc, r.motion.t,
+                             r.motion_covariance_valid ? &r.motion_covariance : nullptr,
+                             orientation_.reported_covariance());
+  r.pose_covariance = pose_covariance_.covariance();
+  r.pose_covariance_gaps = pose_covariance_.gaps();
   r.status = VoStatus::kOk;
   r.message = "ok";
 }

@@ -80,6 +80,7 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
   keyframe_.R_wc = orientation_.R_wc();
   keyframe_.R_wc_covariance = orientation_.covariance();
   keyframe_.centre = centre_;
+  keyframe_.pose_covariance = pose_covariance_.covariance();
   if (input.external.has_lines)
     for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i)
       keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];

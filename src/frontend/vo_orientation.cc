@@ -46,7 +46,7 @@ OrientationFilterOptions filter_options(const VisualOdometryOptions& options) {
 }  // namespace
 
 VoOrientation::VoOrientation(const VisualOdometryOptions& options)
-    : use_map_(options.use_vp_tracker),
+    : use_map_(options.use_direction_map),
       rotation_calibration_sigma_(options.rotation_calibration_sigma),
       seed_sigma_px_(options.estimator.vp_detection.inlier_threshold_px / 3.0),
       seed_sigma_deg_(options.estimator.ransac.vp_threshold_deg / 3.0),

@@ -279,4 +279,16 @@ geometry_msgs::Vector3 to_vector(const Eigen::Vector3d& v) {
 
 geometry_msgs::Point to_point(const Eigen::Vector3d& p) { return tf2::toMsg(p); }
 
+CovarianceArray to_covariance(const Matrix6d& C) {
+  CovarianceArray a;
+  for (int i = 0; i < 36; ++i) a[i] = C(i / 6, i % 6);
+  return a;
+}
+
+CovarianceArray unknown_covariance() {
+  CovarianceArray a{};
+  for (int i = 0; i < 6; ++i) a[i * 7] = 9999.0;
+  return a;
+}
+
 }  // namespace hybrid_vo

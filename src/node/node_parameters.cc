@@ -141,7 +141,7 @@ const std::vector<Parameter>& parameters() {
       field<double>("vp_inlier_threshold_px",
                     NODE_FIELD(double, odometry.estimator.vp_detection.inlier_threshold_px)),
       field<int>("vp_min_inliers", NODE_FIELD(int, odometry.estimator.vp_detection.min_inliers)),
-      field<bool>("vp_tracker", NODE_FIELD(bool, odometry.use_vp_tracker)),
+      field<bool>("direction_map", NODE_FIELD(bool, odometry.use_direction_map)),
       field<bool>("anchor_orientation", NODE_FIELD(bool, odometry.anchor_orientation)),
       field<bool>("coast_blank_walls", NODE_FIELD(bool, odometry.orientation.coast_blank_walls)),
       field<bool>("translation_given_rotation",
@@ -162,6 +162,31 @@ const std::vector<Parameter>& parameters() {
 
 #undef NODE_FIELD
 
+// Old names that still work, each for the parameter that replaced it.
+struct Renamed {
+  std::string old_name, name;
+};
+const std::vector<Renamed>& renamed_parameters() {
+  // Issue 43: the VP tracker became the map of world directions.
+  static const std::vector<Renamed> table = {{"vp_tracker", "direction_map"}};
+  return table;
+}
+
+// The name under which `params` holds the parameter `name`: its own, else an old one (empty:
+// neither). Old names are reported, and ignored beside the new one.
+std::string given_name(const XmlRpcValue& params, const std::string& name,
+                       std::vector<std::string>* warnings) {
+  const bool given = params.hasMember(name);
+  for (const Renamed& r : renamed_parameters()) {
+    if (r.name != name || !params.hasMember(r.old_name)) continue;
+    warnings->push_back(r.old_name + ": deprecated, use " + r.name +
+                        (given ? " (ignored: " + r.name + " is set too)"
+                               : " (taken as " + r.name + ")"));
+    if (!given) return r.old_name;
+  }
+  return given ? name : std::string();
+}
+
 }  // namespace
 
 NodeParameters::NodeParameters() {
@@ -175,16 +200,18 @@ NodeParameters read_node_parameters(const XmlRpcValue& params, std::vector<std::
   NodeParameters out;
   const bool have = params.getType() == XmlRpcValue::TypeStruct;
   std::set<std::string> known;
+  for (const Renamed& r : renamed_parameters()) known.insert(r.old_name);
   for (const Parameter& parameter : parameters()) {
     known.insert(parameter.name);
-    if (!have || !params.hasMember(parameter.name)) continue;
+    const std::string name = have ? given_name(params, parameter.name, warnings) : "";
+    if (name.empty()) continue;
     NodeParameters candidate = out;
-    std::string problem = parameter.set(params[parameter.name], &candidate);
+    std::string problem = parameter.set(params[name], &candidate);
     if (problem.empty()) problem = validate(candidate);
     if (problem.empty()) {
       out = candidate;
     } else {
-      warnings->push_back(parameter.name + ": " + problem + "; keeping the default");
+      warnings->push_back(name + ": " + problem + "; keeping the default");
     }
   }
   if (have) {

@@ -108,7 +108,6 @@ void VoNode::reset_state(const std::string& why) {
   path_.poses.clear();
   looked_up_base_ = false;
   have_base_transform_ = false;
-  last_pose_stamp_ = ros::Time();
   ROS_WARN("hybrid_vo: odometry reset (%s)", why.c_str());
 }
 
@@ -145,7 +144,6 @@ bool VoNode::handle_stream_event(const ros::Time& stamp, int width, int height, 
     reset_state(what);
   } else if (restarts(event)) {
     vo_->restart();
-    last_pose_stamp_ = ros::Time();  // no velocity across the fault
     ROS_WARN("hybrid_vo: %s", what.c_str());
   }
   return true;

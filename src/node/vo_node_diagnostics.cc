@@ -164,6 +164,8 @@ void VoNode::add_counters(diagnostic_updater::DiagnosticStatusWrapper& status) c
                                          {"bad images", bad_images_},
                                          {"bad feature messages", bad_features_},
                                          {"frames without pose", failures_},
+                                         {"pairs without a covariance",
+                                          last_result_.pose_covariance_gaps},
                                          {"incomplete frames dropped", dropped_}})
     status.add(key, count);
   // Load: frames dropped because the processing thread was busy, and the time from a frame's

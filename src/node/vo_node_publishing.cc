@@ -10,6 +10,7 @@
 #include <nav_msgs/Odometry.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/node/conversions.h"
 #include "hybrid_vo/node/vo_node.h"
 
@@ -174,12 +175,12 @@ void VoNode::publish_pose(const ros::Time& stamp, const std::string& camera_fram
   tf.child_frame_id = child;
   tf.transform = to_transform(pose.rotation(), pose.translation());
   if (params_.publish_tf) tf_broadcaster_.sendTransform(tf);
-  publish_odometry(tf, pose, lost);
+  publish_odometry(tf, pose, result, lost);
 }
 
 void VoNode::publish_odometry(const geometry_msgs::TransformStamped& tf,
-                              const Eigen::Isometry3d& pose, bool lost) {
-  const ros::Time& stamp = tf.header.stamp;
+                              const Eigen::Isometry3d& pose, const VisualOdometryResult& result,
+                              bool lost) {
   nav_msgs::Odometry odometry;
   odometry.header = tf.header;
   odometry.child_frame_id = tf.child_frame_id;
@@ -187,20 +188,25 @@ void VoNode::publish_odometry(const geometry_msgs::TransformStamped& tf,
   odometry.pose.pose.position.y = pose.translation().y();
   odometry.pose.pose.position.z = pose.translation().z();
   odometry.pose.pose.orientation = tf.transform.rotation;
-  if (lost) {
-    for (int i = 0; i < 6; ++i) {
-      odometry.pose.covariance[i * 7] = 9999.0;
-      odometry.twist.covariance[i * 7] = 9999.0;
-    }
-  }
-  if (!last_pose_stamp_.isZero() && stamp > last_pose_stamp_) {
-    const double dt = (stamp - last_pose_stamp_).toSec();
-    const Eigen::Vector3d velocity =
-        pose.rotation().transpose() * (pose.translation() - last_centre_) / dt;
-    odometry.twist.twist.linear = to_vector(velocity);
-  }
-  last_pose_stamp_ = stamp;
-  last_centre_ = pose.translation();
+  // The camera's pose covariance goes where the pose goes: through the static transform into
+  // odom -> base_frame. The twist is the pair's mean over its span, in the child frame.
+  const Eigen::Matrix3d R_bc =
+      have_base_transform_ ? R_base_camera_ : Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d t_bc = have_base_transform_ ? t_base_camera_ : Eigen::Vector3d::Zero();
+  odometry.pose.covariance = to_covariance(
+      have_base_transform_ ? body_pose_covariance(result.pose_covariance, result.R_wc, R_bc, t_bc)
+                           : result.pose_covariance);
+  PairTwist twist;
+  const bool twist_known =
+      result.status == VoStatus::kOk &&
+      pair_twist(result.motion.R, result.motion.t, result.motion_covariance,
+                 tf.header.stamp.toSec() - result.reference_stamp, R_bc, t_bc, &twist);
+  odometry.twist.twist.linear = to_vector(twist.linear);
+  odometry.twist.twist.angular = to_vector(twist.angular);
+  odometry.twist.covariance = twist_known && result.motion_covariance_valid
+                                  ? to_covariance(twist.covariance)
+                                  : unknown_covariance();
+  if (lost) odometry.pose.covariance = odometry.twist.covariance = unknown_covariance();
   odometry_pub_.publish(odometry);
 
   geometry_msgs::PoseStamped p;

@@ -39,8 +39,8 @@ void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
-               " [--drop-leaving] [--no-anchor] [--no-vp-tracker] [--seed S] [--opencv-threads N]"
-               " [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
+               " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
+               " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
@@ -48,7 +48,8 @@ void usage(const char* program) {
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
                "  the KLT corners' strength floor (0: every corner); --drop-leaving: KLT drops\n"
                "  the features predicted outside the image unsearched; --no-anchor: no orientation\n"
-               "  correction by the map of directions. Default preset hybrid+junc.\n"
+               "  correction by the map of directions; --no-direction-map (old name:\n"
+               "  --no-vp-tracker): no map of directions at all. Default preset hybrid+junc.\n"
                "  --opencv-threads N: OpenCV's own thread pool (cv::setNumThreads), as the node's\n"
                "  opencv_threads parameter; default 1 (none: the front end splits its work over\n"
                "  its two threads itself); -1 leaves OpenCV's default.\n"
@@ -170,7 +171,7 @@ int run(int argc, char** argv) {
     else if (a == "--klt-iterations" && i + 1 < argc) o.klt.max_iterations = std::atoi(argv[++i]);
     else if (a == "--klt-levels" && i + 1 < argc) o.klt.pyramid_levels = std::atoi(argv[++i]);
     else if (a == "--max-features" && i + 1 < argc) max_features = std::atoi(argv[++i]);
-    else if (a == "--no-vp-tracker") o.use_vp_tracker = false;
+    else if (a == "--no-direction-map" || a == "--no-vp-tracker") o.use_direction_map = false;
     else if (a == "--no-anchor") o.anchor_orientation = false;
     else if (a == "--coast") o.orientation.coast_blank_walls = true;
     else if (a == "--translation-given-rotation") o.orientation.translation_given_rotation = true;
@@ -352,9 +353,11 @@ int run(int argc, char** argv) {
                                                                      C.bottomRightCorner<3, 3>(),
                                                                      truth_direction_sigma)
                                         : NAN);
-          // The orientation's covariance as the node reports it (VoOrientation::reported_covariance).
+          // The orientation's covariance as the node reports it: the pose covariance's rotation
+          // block (VoOrientation::reported_covariance).
           orientation_nees.push_back(evaluation::orientation_nees(
-              odometry.front().R, r.R_wc, gt[0].R_wc, gt[i].R_wc, r.orientation_covariance,
+              odometry.front().R, r.R_wc, gt[0].R_wc, gt[i].R_wc,
+              Eigen::Matrix3d(r.pose_covariance.bottomRightCorner<3, 3>()),
               truth_orientation_sigma));
         }
         pose_errors.push_back(error);

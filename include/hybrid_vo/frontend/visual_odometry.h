@@ -18,6 +18,7 @@
 #include "hybrid_vo/frontend/stereo.h"
 #include "hybrid_vo/frontend/vo_orientation.h"
 #include "hybrid_vo/frontend/worker_thread.h"
+#include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/lines/two_view.h"
 
 namespace hybrid_vo {
@@ -67,7 +68,7 @@ struct VisualOdometryOptions {
   // per axis): it tells a pair whose points barely separate rotation from translation (white
   // panels seen from 2 m: 0.08 deg) from a well conditioned one (KITTI: 0.003 deg), where VPs,
   // with their tenths of a degree of noise, must not move it.
-  bool use_vp_tracker = true;
+  bool use_direction_map = true;
   bool anchor_orientation = true;
   OrientationFilterOptions orientation;
   // How far every estimated rotation may be off as a whole, in its angle and in its axis (a
@@ -85,7 +86,7 @@ struct VisualOdometryOptions {
 template <typename Visit>
 void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(any_value(), o.use_lines, o.track_lines, o.concurrent,
-                  o.stereo_current_disparity, o.stereo_refine_tracks, o.use_vp_tracker,
+                  o.stereo_current_disparity, o.stereo_refine_tracks, o.use_direction_map,
                   o.anchor_orientation);
   visit("max_features", o.features.points.max_features, positive());
   visit_fields(o.klt, prefixed("klt_", visit));
@@ -151,12 +152,19 @@ struct VisualOdometryResult {
   std::vector<StereoScaleObservation> scale_observations;
   double disparity_offset_px = 0.0;  // the offset applied (0 until self-calibration is sure)
   Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
-  // Of a left increment of R_wc, odometry frame (rad^2): VoOrientation::reported_covariance.
-  Eigen::Matrix3d orientation_covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
+  // Of this pose (R_wc, centre), [position, rotation as a left increment of R_wc] in the odometry
+  // frame (ROS's order, geometry/pose_covariance.h): the rotation block is the orientation's as
+  // reported (VoOrientation::reported_covariance: the map's, with the pairs' correlated errors
+  // bounded); the position is chained over the integrated pairs to first order, with its cross
+  // terms. Without a metric scale the position is in units of mono_scale per pair and knows
+  // nothing of the scale's drift. Zero at the first frame (and after a reset); a restart keeps
+  // it, as it keeps the pose.
+  Matrix6d pose_covariance = Matrix6d::Zero();
+  int pose_covariance_gaps = 0;  // integrated pairs without a usable covariance, ever
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
   std::vector<int> vp_track_ids; // per VP match of the pair: the map direction of its prior, or -1
-  // How the map of directions placed this frame (with use_vp_tracker): the orientation's source,
+  // How the map of directions placed this frame (with use_direction_map): the orientation's source,
   // the directions each VP was paired with, blank wall, correction.
   OrientationEstimate orientation;
   int num_point_matches = 0, num_line_matches = 0;
@@ -214,6 +222,7 @@ class VisualOdometry {
     Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d R_wc_covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    Matrix6d pose_covariance = Matrix6d::Zero();
   };
 
   // The stereo matching of features by id (the searches are left to the caller).
@@ -305,6 +314,7 @@ class VisualOdometry {
   DisparityOffsetFilter offset_filter_;
   Keyframe keyframe_;
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
+  PoseCovarianceChain pose_covariance_;
   double last_stamp_ = -1e300;
 };
 

@@ -19,7 +19,7 @@ struct VisualOdometryOptions;
 // it wherever the camera sees them, finds them again after a blank wall, and overrules a pair
 // whose rotation its directions contradict (OrientationFilter). The map gives the pair's VPs their
 // priors. Also the camera's last rotation rate, which predicts how the segments move in the next
-// frame and carries a blank wall when coasting. Used by VisualOdometry (use_vp_tracker: the map,
+// frame and carries a blank wall when coasting. Used by VisualOdometry (use_direction_map: the map,
 // anchor_orientation: its corrections, orientation).
 class VoOrientation {
  public:

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include <geometry_msgs/Point.h>
+#include <geometry_msgs/PoseWithCovariance.h>
 #include <geometry_msgs/Transform.h>
 #include <geometry_msgs/Vector3.h>
 #include <hybrid_vo/FeatureLines.h>
@@ -53,5 +54,11 @@ bool lines_from_vins(const sensor_msgs::PointCloud& msg, const PinholeCamera& ca
 geometry_msgs::Transform to_transform(const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
 geometry_msgs::Vector3 to_vector(const Eigen::Vector3d& v);
 geometry_msgs::Point to_point(const Eigen::Vector3d& p);
+
+// A 6x6 covariance as a message's row-major array (the pose's and twist's of nav_msgs/Odometry).
+using CovarianceArray = geometry_msgs::PoseWithCovariance::_covariance_type;
+CovarianceArray to_covariance(const Matrix6d& C);
+// What a lost track or an unknown twist reports, as viso2 does: 9999 on the diagonal.
+CovarianceArray unknown_covariance();
 
 }  // namespace hybrid_vo

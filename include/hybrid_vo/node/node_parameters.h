@@ -56,7 +56,8 @@ void visit_fields(NodeParameters& p, Visit&& visit) {
 // parameter server's answer for it). A value of the wrong type, an unknown choice, or one that
 // makes validate() fail is named in `warnings` and leaves that parameter's default. The preset
 // is applied before the thresholds, so that those override it. Parameters the node does not know
-// (a misspelt name) are named in `warnings` too.
+// (a misspelt name) are named in `warnings` too, and so are the old names of renamed ones, which
+// still take effect unless the new name is set as well (vp_tracker: direction_map).
 NodeParameters read_node_parameters(const XmlRpc::XmlRpcValue& params,
                                     std::vector<std::string>* warnings);
 

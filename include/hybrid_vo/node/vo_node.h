@@ -138,8 +138,10 @@ class VoNode {
   void publish_pose(const ros::Time& stamp, const std::string& camera_frame,
                     const VisualOdometryResult& result, bool lost);
   void look_up_base_transform(const std::string& camera_frame);
+  // The pose with its covariance (mapped like the pose) and the pair's twist in the child frame;
+  // lost, or without a pair (first frame): the twist's covariance says "unknown".
   void publish_odometry(const geometry_msgs::TransformStamped& tf, const Eigen::Isometry3d& pose,
-                        bool lost);
+                        const VisualOdometryResult& result, bool lost);
   void publish_vanishing_points(const ros::Time& stamp, const VisualOdometryResult& result);
   // The odometry frame's orientation in the first camera's frame ("world"): the static base ->
   // camera rotation when there is one.
@@ -204,8 +206,6 @@ class VoNode {
   Eigen::Matrix3d R_base_camera_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t_base_camera_ = Eigen::Vector3d::Zero();
   std::string camera_frame_;
-  ros::Time last_pose_stamp_;
-  Eigen::Vector3d last_centre_ = Eigen::Vector3d::Zero();
 
   // Diagnostics: written by both sides and read by diagnose(), under stats_mutex_.
   std::mutex stats_mutex_;
