@@ -65,7 +65,11 @@ OrientationEstimate OrientationFilter::predict(const Eigen::Matrix3d& R1,
   e.R_world_from_camera = R1;
   e.covariance = P1;
   if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
-  e.location.joint = predict(R1, P1, pair, 0.0, &e.R_world_from_camera, &e.covariance);
+  // A blank wall is the pair's, map or not.
+  e.blank_wall = pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
+  e.blank_wall_sigma_rad = e.blank_wall ? blank_wall_sigma(pair.R) : 0.0;
+  e.location.joint =
+      predict(R1, P1, pair, e.blank_wall_sigma_rad, &e.R_world_from_camera, &e.covariance);
   e.predicted_covariance = e.covariance;
   e.location.has_joint = true;
   for (const MapDirection& d : map_.directions()) e.location.directions.push_back(d.direction);

@@ -146,6 +146,8 @@ const std::vector<Parameter>& parameters() {
       field<bool>("coast_blank_walls", NODE_FIELD(bool, odometry.orientation.coast_blank_walls)),
       field<bool>("translation_given_rotation",
                   NODE_FIELD(bool, odometry.orientation.translation_given_rotation)),
+      field<double>("rotation_calibration_sigma",
+                    NODE_FIELD(double, odometry.rotation_calibration_sigma)),
       field<double>("mono_scale", NODE_FIELD(double, odometry.mono_scale)),
       field<double>("stereo_max_depth_baselines",
                     NODE_FIELD(double, odometry.stereo_scale.max_depth_baselines)),

@@ -117,7 +117,8 @@ class OrientationFilter {
                                const PairRotation& pair) const;
   // The uncertainty (rad, per axis) a blank wall's pair rotation R gets beyond its covariance.
   double blank_wall_sigma(const Eigen::Matrix3d& R) const;
-  // The pair's prediction alone, without the map: its rotation and its covariance grown by it.
+  // The pair's prediction alone, without the map: its rotation and its covariance grown by it
+  // (and by a blank wall's uncertainty when it is one).
   OrientationEstimate predict(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
                               const PairRotation& pair) const;
   // Takes the frame into the map (after estimate, with its result).
