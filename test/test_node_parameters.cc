@@ -99,6 +99,8 @@ std::vector<Case> every_parameter() {
       {"coast_blank_walls", true, [](P p) { return p.odometry.orientation.coast_blank_walls; }},
       {"translation_given_rotation", true,
        [](P p) { return p.odometry.orientation.translation_given_rotation; }},
+      {"rotation_calibration_sigma", 0.02,
+       [](P p) { return p.odometry.rotation_calibration_sigma == 0.02; }},
       {"mono_scale", 0.5, [](P p) { return p.odometry.mono_scale == 0.5; }},
       {"stereo_max_depth_baselines", 60.0,
        [](P p) { return p.odometry.stereo_scale.max_depth_baselines == 60.0; }},
