@@ -180,7 +180,8 @@ double vp_prior_chi2(const HybridProblem& problem, const TwoViewMatches& matches
 // those that pass pull a second refinement, which starts from the first.
 void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
                   const RelativePoseEstimatorOptions& options, const TwoViewMatches& matches,
-                  RelativePoseEstimate* est, InformationSplit* split) {
+                  const HybridRansacOutcome& outcome, RelativePoseEstimate* est,
+                  InformationSplit* split) {
   std::vector<char> pool, vps;
   const int pool_before = scorer.pool_inliers(est->pose, &pool);
   scorer.vp_inliers(est->pose, &vps);
@@ -240,14 +241,30 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
   }
 
   if (matches.vp_priors.size() != matches.vps.size() || data.vps.empty()) return;
-  // Against a prior, which carries many frames, the pair's point matches are not independent
-  // (KLT's errors correlate between neighbouring tracks and from frame to frame; calibration
-  // and rolling shutter shift all of them): together they count as at most
-  // max_independent_points matches, in the gate (their rotation's covariance) and in the
-  // refinement with the priors. A pair alone (no prior) keeps the measured sigmas.
-  const double dependence = std::sqrt(
+  // Against a prior, which carries many frames, the pair's points weigh what they know: their
+  // rotation's variance as the pair reports it (pair_covariance.h: the points counted as
+  // independent_points, the spread of the competing rotations added) over what their residuals
+  // say, in the gate (their rotation's covariance) and in the refinement with the priors. Where
+  // the split is missing, they count as at most max_independent_points matches. A pair alone (no
+  // prior) keeps the measured sigmas.
+  double dependence = std::sqrt(
       std::max(1.0, static_cast<double>(data.points.size()) /
                         std::max(1.0, options.scales.max_independent_points)));
+  const PairCovarianceOptions& honest = options.covariance;
+  if (honest.enabled && split->valid) {
+    std::vector<RotationHypothesis> hypotheses;
+    for (const ScoredRotation& h : outcome.near_best) hypotheses.push_back({h.R, h.cost});
+    const double n = static_cast<double>(data.points.size());
+    const Eigen::Matrix3d own = split->points_covariance.topLeftCorner<3, 3>();
+    const Eigen::Matrix3d weighed =
+        std::max(1.0, n / honest.independent_points) * own +
+        rotation_spread(hypotheses, est->pose.R, outcome.best_cost,
+                        hypothesis_temperature(n, honest.ambiguity_independent_points,
+                                               est->scales.point_px,
+                                               options.ransac.point_threshold_px));
+    if (own.trace() > 0.0 && all_finite(weighed))
+      dependence = std::sqrt(std::max(1.0, weighed.trace() / own.trace()));
+  }
   for (double& sigma : data.point_sigma_px) sigma *= dependence;
   est->scales.point_dependence = dependence;
   data.vp_priors.assign(data.vps.size(), VpPrior());
@@ -405,7 +422,7 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
   InformationSplit split;
   if (options.refinement.enabled) {
     const auto refine_start = std::chrono::steady_clock::now();
-    refine_final(problem, scorer, options, matches, &est, &split);
+    refine_final(problem, scorer, options, matches, outcome, &est, &split);
     est.refine_ms = ms_since(refine_start);
   }
   // The Sampson error cannot tell t from -t, and the minimal sample that fixed the sign was
