@@ -37,15 +37,10 @@ struct ModalityScaleOptions {
   double min_point_px = 0.05, min_line_px = 0.05, min_vp_deg = 0.005;
   // The residual of a point match shows its own noise, not the errors it shares with its
   // neighbours (KLT's correlated errors, calibration, rolling shutter), which no single pair can
-  // measure: split-half tests (the image's left against its right half, top against bottom) find
-  // the points' rotations 1.7-2x further apart than their covariances allow at the median, 4x at
-  // the 90th percentile, on both KITTI and the rendered corridor. Against a VP prior, which
-  // carries many frames, the point-like matches of a pair therefore count as at most this many
-  // independent ones (sigma times sqrt(n / this)), in the prior's gate and in the refinement with
-  // it. Measured through the odometry (doc/vanishing_points.md): 16 keeps KITTI
-  // within 0.01 deg/100 m of unlimited points and takes the rendered corridor from 21 to 3
-  // deg/100 m. A pair alone keeps the measured sigmas: at 16 the Strecha pairs at gaps 2 and 3
-  // lost 0.1-0.3 AUC@10 to 5pc.
+  // measure. Against a VP prior, which carries many frames, the point-like matches therefore
+  // weigh what the pair's honest covariance says they know (pair_covariance.h); where it has none,
+  // they count as at most this many independent ones (sigma times sqrt(n / this)), in the prior's
+  // gate and in the refinement with it. A pair alone keeps the measured sigmas.
   double max_independent_points = 16.0;
 };
 
