@@ -52,6 +52,15 @@ double chi2_against(const MapDirection& d, const Eigen::Vector3d& w, const Eigen
   return direction_chi2(d.direction, w, d.covariance + C, false);
 }
 
+// Where the map could not place a camera: as predicted, nothing paired.
+MapLocation unlocated(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P, size_t observations) {
+  MapLocation where;
+  where.R_world_from_camera = R;
+  where.covariance = P;
+  where.direction_id.assign(observations, -1);
+  return where;
+}
+
 }  // namespace
 
 double MapDirection::sigma_deg() const { return largest_sigma(covariance) / kDeg; }
@@ -163,13 +172,7 @@ bool DirectionMap::pinnable() const {
 
 MapLocation DirectionMap::locate(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                                  const std::vector<VpObservation>& observations) const {
-  if (!is_covariance(P)) {
-    MapLocation where;
-    where.R_world_from_camera = R;
-    where.covariance = P;
-    where.direction_id.assign(observations.size(), -1);
-    return where;
-  }
+  if (!is_covariance(P)) return unlocated(R, P, observations.size());
   return locate_with(R, prediction(P), observations, nullptr);
 }
 
@@ -181,13 +184,7 @@ MapLocation DirectionMap::locate(const Eigen::Matrix3d& R, const JointOrientatio
 MapLocation DirectionMap::locate_known(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                                        const std::vector<VpObservation>& observations,
                                        const std::vector<int>& direction_ids) const {
-  if (!is_covariance(P)) {
-    MapLocation where;
-    where.R_world_from_camera = R;
-    where.covariance = P;
-    where.direction_id.assign(observations.size(), -1);
-    return where;
-  }
+  if (!is_covariance(P)) return unlocated(R, P, observations.size());
   return locate_with(R, prediction(P), observations, &direction_ids);
 }
 
