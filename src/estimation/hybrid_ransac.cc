@@ -82,13 +82,13 @@ class LocalOptimizer {
 };
 
 // Keeps the hypotheses within `margin` of `best`, at most `cap` of the cheapest.
-void prune_near_best(double best, double margin, size_t cap, std::vector<ScoredRotation>* kept) {
+void prune_near_best(double best, double margin, size_t cap, std::vector<RotationHypothesis>* kept) {
   kept->erase(std::remove_if(kept->begin(), kept->end(),
-                             [&](const ScoredRotation& h) { return !(h.cost < best + margin); }),
+                             [&](const RotationHypothesis& h) { return !(h.cost < best + margin); }),
               kept->end());
   if (kept->size() <= cap) return;
   std::nth_element(kept->begin(), kept->begin() + cap, kept->end(),
-                   [](const ScoredRotation& a, const ScoredRotation& b) { return a.cost < b.cost; });
+                   [](const RotationHypothesis& a, const RotationHypothesis& b) { return a.cost < b.cost; });
   kept->resize(cap);
 }
 

@@ -7,15 +7,10 @@
 #include <vector>
 
 #include "hybrid_problem.h"
+#include "hybrid_vo/estimation/pair_covariance.h"
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
 
 namespace hybrid_vo {
-
-// A hypothesis RANSAC scored, with its truncated cost (ModelScorer::cost).
-struct ScoredRotation {
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  double cost = 0.0;
-};
 
 struct HybridRansacOutcome {
   bool any_solver_available = false;
@@ -29,7 +24,7 @@ struct HybridRansacOutcome {
   // The minimal-sample hypotheses whose cost came within `near_best_margin` of the best cost
   // (the final best's), at most `max_near_best` of the cheapest: the models the data could not
   // rule out (pair_covariance.h).
-  std::vector<ScoredRotation> near_best;
+  std::vector<RotationHypothesis> near_best;
 };
 
 HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,

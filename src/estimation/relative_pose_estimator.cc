@@ -174,6 +174,17 @@ double vp_prior_chi2(const HybridProblem& problem, const TwoViewMatches& matches
                         static_cast<bool>(problem.vp_sign_known[k]));
 }
 
+// The spread of RANSAC's competing rotations about R, `points` point-like matches of the
+// estimate's measured noise (pair_covariance.h).
+Eigen::Matrix3d competing_spread(const HybridRansacOutcome& outcome, const Eigen::Matrix3d& R,
+                                 double points, const RelativePoseEstimate& est,
+                                 const RelativePoseEstimatorOptions& options) {
+  return rotation_spread(
+      outcome.near_best, R, outcome.best_cost,
+      hypothesis_temperature(points, options.covariance.ambiguity_independent_points,
+                             est.scales.point_px, options.ransac.point_threshold_px));
+}
+
 // Ceres refinement on the inliers (paper Sec. 4, final step), every residual weighted by its
 // modality's measured scale; kept unless it loses inliers. Then the VP priors: each is gated
 // against the rotation this pair's own data support (the refined pose and its covariance), and
@@ -252,16 +263,10 @@ void refine_final(const HybridProblem& problem, const ModelScorer& scorer,
                         std::max(1.0, options.scales.max_independent_points)));
   const PairCovarianceOptions& honest = options.covariance;
   if (honest.enabled && split->valid) {
-    std::vector<RotationHypothesis> hypotheses;
-    for (const ScoredRotation& h : outcome.near_best) hypotheses.push_back({h.R, h.cost});
     const double n = static_cast<double>(data.points.size());
     const Eigen::Matrix3d own = split->points_covariance.topLeftCorner<3, 3>();
-    const Eigen::Matrix3d weighed =
-        std::max(1.0, n / honest.independent_points) * own +
-        rotation_spread(hypotheses, est->pose.R, outcome.best_cost,
-                        hypothesis_temperature(n, honest.ambiguity_independent_points,
-                                               est->scales.point_px,
-                                               options.ransac.point_threshold_px));
+    const Eigen::Matrix3d weighed = std::max(1.0, n / honest.independent_points) * own +
+                                    competing_spread(outcome, est->pose.R, n, *est, options);
     if (own.trace() > 0.0 && all_finite(weighed))
       dependence = std::sqrt(std::max(1.0, weighed.trace() / own.trace()));
   }
@@ -399,10 +404,8 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
   std::mt19937_64 rng(options.ransac.seed);
   const PairCovarianceOptions& honest = options.covariance;
   const HybridRansacOutcome outcome =
-      honest.enabled
-          ? run_hybrid_ransac(problem, options.ransac, &rng, honest.hypothesis_margin,
-                              honest.max_hypotheses)
-          : run_hybrid_ransac(problem, options.ransac, &rng);
+      run_hybrid_ransac(problem, options.ransac, &rng,
+                        honest.enabled ? honest.hypothesis_margin : 0.0, honest.max_hypotheses);
   est.ransac_ms = ms_since(ransac_start);
   est.solvers = outcome.solvers;
   est.iterations = outcome.iterations;
@@ -431,14 +434,8 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
   fill_inliers(problem, scorer, options, matches, &est);
   est.hessian_covariance = est.covariance;
   if (honest.enabled && est.covariance_valid) {
-    std::vector<RotationHypothesis> hypotheses;
-    for (const ScoredRotation& h : outcome.near_best) hypotheses.push_back({h.R, h.cost});
     const double point_matches = est.num_point_inliers + est.num_junction_inliers;
-    const double temperature =
-        hypothesis_temperature(point_matches, honest.ambiguity_independent_points,
-                               est.scales.point_px, options.ransac.point_threshold_px);
-    est.rotation_spread =
-        rotation_spread(hypotheses, est.pose.R, outcome.best_cost, temperature);
+    est.rotation_spread = competing_spread(outcome, est.pose.R, point_matches, est, options);
     if (!pair_covariance(split, est.rotation_spread, point_matches, est.num_line_inliers, honest,
                          &est.covariance)) {
       // The points alone do not fix the pose (too few, or VPs carry it): the refinement's
