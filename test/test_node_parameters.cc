@@ -81,6 +81,8 @@ std::vector<Case> every_parameter() {
       {"min_parallax_px", 3.5, [](P p) { return p.odometry.min_parallax_px == 3.5; }},
       {"track_lines", false, [](P p) { return !p.odometry.track_lines; }},
       {"concurrent_frontend", false, [](P p) { return !p.odometry.concurrent; }},
+      {"max_cpu_ms", 8.5, [](P p) { return p.odometry.budget.max_cpu_ms == 8.5; }},
+      {"min_work_level", 2, [](P p) { return p.odometry.budget.min_work_level == 2; }},
       {"opencv_threads", -1, [](P p) { return p.opencv_threads == -1; }},
       {"klt_predict_motion", false, [](P p) { return !p.odometry.klt.predict_motion; }},
       {"klt_window_px", 21, [](P p) { return p.odometry.klt.window_px == 21; }},

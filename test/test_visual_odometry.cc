@@ -154,6 +154,41 @@ TEST_F(VideoFrontEnd, ThreadedFrontEndGivesTheSequentialMatchesAndPoses) {
   expect_threaded_equals_sequential(stereo, descriptors);
 }
 
+// The lightest fixed work level (cpu_budget.h): half the point budget, no segment descriptors, so
+// no re-identification and no candidate told apart by one, and yet the corridor's motion.
+TEST_F(VideoFrontEnd, TheLightestWorkLevelDoesLessAndStillFollowsTheCorridor) {
+  auto run = [](int level, std::vector<VisualOdometryResult>* results) {
+    VisualOdometryOptions options;
+    options.features.points.max_features = 400;
+    options.budget.min_work_level = level;
+    VisualOdometry vo(options);
+    for (int i = 0; i < kFrames; ++i) results->push_back(vo.process(input(i, false)));
+  };
+  std::vector<VisualOdometryResult> full, light;
+  run(0, &full);
+  run(kMaxWorkLevel, &light);
+  const CameraPose first = frame_pose(*sequence_, 0);
+  int estimated = 0, most_points_full = 0, most_points_light = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    EXPECT_EQ(full[i].work_level, 0);
+    EXPECT_EQ(light[i].work_level, kMaxWorkLevel);
+    EXPECT_EQ(light[i].line_tracking.reidentified, 0);
+    EXPECT_EQ(light[i].line_tracking.ambiguous, 0);
+    EXPECT_LE(light[i].num_point_matches, 200);
+    most_points_full = std::max(most_points_full, full[i].num_point_matches);
+    most_points_light = std::max(most_points_light, light[i].num_point_matches);
+    if (light[i].status != VoStatus::kOk) continue;
+    ++estimated;
+    const Eigen::Matrix3d truth = first.R_world_from_camera.transpose() *
+                                  frame_pose(*sequence_, i).R_world_from_camera;
+    EXPECT_LT(Eigen::AngleAxisd(light[i].R_wc.transpose() * truth).angle() * 180.0 / M_PI, 0.5);
+  }
+  EXPECT_GT(most_points_full, 200);  // the full level used the whole budget, the light one half
+  EXPECT_GT(most_points_light, 100);
+  EXPECT_GE(estimated, kFrames / 2);
+}
+
 // A colour camera's frames are converted to grey once, where they come in: BGR copies of the
 // grey frames (which cv::cvtColor turns back into the grey ones exactly) give their odometry.
 TEST_F(VideoFrontEnd, ColourFramesGiveTheGreyFramesOdometry) {

@@ -59,7 +59,14 @@ double corner_gradient(const cv::Mat& gray, const cv::Point2f& p, int window) {
 }  // namespace
 
 KltTracker::KltTracker(const KltTrackerOptions& options, int max_features)
-    : options_(options), max_features_(max_features) {}
+    : options_(options),
+      max_features_(max_features),
+      redetect_min_missing_(options.redetect_min_missing) {}
+
+void KltTracker::set_work(int max_features, double redetect_min_missing) {
+  max_features_ = std::max(1, max_features);
+  redetect_min_missing_ = std::clamp(redetect_min_missing, 0.0, 1.0);
+}
 
 void KltTracker::reset() {
   previous_.clear();
@@ -268,7 +275,11 @@ KltDetection KltTracker::plan_detection() const {
     cv::circle(d.mask, p, static_cast<int>(options_.min_distance_px), cv::Scalar(0), cv::FILLED);
   }
   d.wanted.resize(d.cells());
-  for (int c = 0; c < d.cells(); ++c) d.wanted[c] = quota - count[c];
+  const int min_missing = static_cast<int>(std::ceil(redetect_min_missing_ * quota));
+  for (int c = 0; c < d.cells(); ++c) {
+    d.wanted[c] = quota - count[c];
+    if (d.wanted[c] < min_missing) d.wanted[c] = 0;
+  }
   d.corners.resize(d.cells());
   d.strong.resize(d.cells());
   return d;

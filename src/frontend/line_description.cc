@@ -147,6 +147,10 @@ LineFeatures describe_line_segments(const GrayImage& image,
     add_keylines(s, mid, id, octaves, base_scale, std::max(gray.cols, gray.rows), &keylines);
   }
   if (keylines.empty()) return LineFeatures();
+  if (!options.describe) {
+    if (kept) *kept = indices;
+    return features;
+  }
   return describe_keylines(base, keylines, features.segments, indices, octaves, options, kept);
 }
 

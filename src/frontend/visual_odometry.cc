@@ -45,7 +45,10 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
       klt_(options.klt, options.features.points.max_features),
       line_tracker_(options.line_tracking, options.features.lines),
       orientation_(options),
-      offset_filter_(options.stereo_offset) {}
+      offset_filter_(options.stereo_offset),
+      budget_(options.budget) {
+  apply_work_level(budget_.level());
+}
 
 VisualOdometry::~VisualOdometry() = default;
 
@@ -70,6 +73,10 @@ VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
   // Each thread's CPU time for this frame: every job of the frame is done by now.
   r.stages.caller_cpu_ms = thread_cpu_ms() - caller_cpu_start;
   r.stages.worker_cpu_ms = worker_->cpu_ms() - worker_cpu_start;
+  r.work_level = budget_.level();
+  const int next = budget_.update(r.stages.caller_cpu_ms + r.stages.worker_cpu_ms);
+  r.average_cpu_ms = budget_.average_cpu_ms();
+  if (next != r.work_level) apply_work_level(next);
   return r;
 }
 

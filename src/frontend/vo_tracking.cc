@@ -26,9 +26,20 @@ std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
   return points;
 }
 
+void VisualOdometry::apply_work_level(int level) {
+  const KltTrackerOptions& klt = options_.klt;
+  const int max_features = options_.features.points.max_features;
+  klt_.set_work(level >= 3 ? std::max(1, max_features / 2) : max_features,
+                level >= 1 ? std::max(0.5, klt.redetect_min_missing) : klt.redetect_min_missing);
+  line_tracker_.set_reidentify(level < 1 && options_.line_tracking.reidentify);
+  describe_segments_ = level < 2 && options_.features.lines.description.describe;
+}
+
 void VisualOdometry::track_segments(Frame& f) {
   const auto lines_start = std::chrono::steady_clock::now();
-  f.features.lines = detect_line_features(f.gray, options_.features.lines);
+  LineMatchingOptions lines = options_.features.lines;
+  lines.description.describe = describe_segments_;
+  f.features.lines = detect_line_features(f.gray, lines);
   if (options_.track_lines)
     f.line_ids = line_tracker_.track(f.features.lines, f.input.stamp, &f.result.line_tracking,
                                      f.segment_motion);

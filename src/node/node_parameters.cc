@@ -129,6 +129,8 @@ const std::vector<Parameter>& parameters() {
       field<double>("min_parallax_px", NODE_FIELD(double, odometry.min_parallax_px)),
       field<bool>("track_lines", NODE_FIELD(bool, odometry.track_lines)),
       field<bool>("concurrent_frontend", NODE_FIELD(bool, odometry.concurrent)),
+      field<double>("max_cpu_ms", NODE_FIELD(double, odometry.budget.max_cpu_ms)),
+      field<int>("min_work_level", NODE_FIELD(int, odometry.budget.min_work_level)),
       field<int>("opencv_threads", NODE_FIELD(int, opencv_threads)),
       field<bool>("klt_predict_motion", NODE_FIELD(bool, odometry.klt.predict_motion)),
       field<int>("klt_window_px", NODE_FIELD(int, odometry.klt.window_px)),

@@ -125,6 +125,11 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("stereo (ms)", r.stages.stereo_ms);
   status.add("CPU, processing thread (ms)", r.stages.caller_cpu_ms);
   status.add("CPU, front end's second thread (ms)", r.stages.worker_cpu_ms);
+  // The CPU budget (max_cpu_ms, 0: none): the recent frames' average against it, and the level
+  // of work the frame was done at (cpu_budget.h: 0 everything, 3 the lightest).
+  status.add("CPU per frame, recent average (ms)", r.average_cpu_ms);
+  status.add("CPU budget (ms)", params_.odometry.budget.max_cpu_ms);
+  status.add("work level", r.work_level);
   status.add("segment tracks found", r.line_tracking.matched);
   status.add("segment tracks started", r.line_tracking.started);
 }

@@ -7,6 +7,7 @@
 // `valgrind --tool=callgrind --toggle-collect='hybrid_vo::VisualOdometry::process*'` with
 // --sequential it gives instruction counts per configuration.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cmath>
@@ -34,6 +35,7 @@ namespace hybrid_vo {
 namespace {
 
 using evaluation::median;
+using evaluation::percentile;
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
@@ -41,7 +43,8 @@ void usage(const char* program) {
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
                " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
-               " [--truth-orientation-sigma-deg S] [--verbose]\n"
+               " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
+               " [--max-features N] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
@@ -66,7 +69,10 @@ void usage(const char* program) {
                "  of the orientation against the first frame under the orientation's covariance,\n"
                "  as hybrid_vo_eval_trajectory prints them; --truth-rotation-sigma-deg,\n"
                "  --truth-direction-sigma-deg and --truth-orientation-sigma-deg add the truth's\n"
-               "  own noise (degrees per axis) as there.\n";
+               "  own noise (degrees per axis) as there.\n"
+               "  --max-cpu-ms B: the node's max_cpu_ms, a CPU budget per frame (both threads);\n"
+               "  --work-level L: its min_work_level, a fixed level 0-3 (cpu_budget.h);\n"
+               "  --max-features N: the point budget (default 1500, as config/kitti.yaml).\n";
 }
 
 // The median of each coordinate.
@@ -166,6 +172,8 @@ int run(int argc, char** argv) {
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--drop-leaving") o.klt.drop_leaving = true;
+    else if (a == "--max-cpu-ms" && i + 1 < argc) o.budget.max_cpu_ms = std::atof(argv[++i]);
+    else if (a == "--work-level" && i + 1 < argc) o.budget.min_work_level = std::atoi(argv[++i]);
     else if (a == "--stereo") stereo = true;
     else if (a == "--klt-window" && i + 1 < argc) o.klt.window_px = std::atoi(argv[++i]);
     else if (a == "--klt-iterations" && i + 1 < argc) o.klt.max_iterations = std::atoi(argv[++i]);
@@ -298,6 +306,7 @@ int run(int argc, char** argv) {
   };
 
   VisualOdometry vo(o);
+  std::array<int, kMaxWorkLevel + 1> frames_at_level{};
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
       stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
@@ -457,6 +466,7 @@ int run(int argc, char** argv) {
     caller_cpu.push_back(r.stages.caller_cpu_ms);
     worker_cpu.push_back(r.stages.worker_cpu_ms);
     longest_cpu.push_back(std::max(r.stages.caller_cpu_ms, r.stages.worker_cpu_ms));
+    ++frames_at_level[std::clamp(r.work_level, 0, kMaxWorkLevel)];
     total.push_back(r.total_ms);
     frontend.push_back(r.frontend_ms);
     estimator.push_back(r.estimator_ms);
@@ -501,6 +511,10 @@ int run(int argc, char** argv) {
   // its longer thread's CPU time.
   std::printf("CPU ms per frame (median) by thread: calling %.1f, worker %.1f, the longer %.1f\n",
               median(caller_cpu), median(worker_cpu), median(longest_cpu));
+  std::printf("CPU per frame: p95 %.1f ms; budget %.1f ms (0: none); frames at work level 0/1/2/3:",
+              percentile(cpu, 0.95), o.budget.max_cpu_ms);
+  for (int n : frames_at_level) std::printf(" %d", n);
+  std::printf("\n");
   if (stereo) {
     double n = 0.0;
     for (double s : scaled) n += s;

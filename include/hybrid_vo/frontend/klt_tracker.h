@@ -50,6 +50,9 @@ struct KltTrackerOptions {
   // them inside again, and dropping them costs accuracy (rendered corridors 1.3-1.7 -> 1.6-2.2
   // deg/100 m; doc/performance.md). So off by default.
   bool drop_leaving = false;
+  // A cell is re-detected only once it misses this fraction of its quota: finding one or two
+  // corners costs goodFeaturesToTrack over the whole cell, and most new features die young.
+  double redetect_min_missing = 0.0;
 };
 
 // Re-detection's work, cell by cell (KltTracker::plan_detection, detect_cell, add_detections).
@@ -70,6 +73,7 @@ void visit_fields(KltTrackerOptions& o, Visit&& visit) {
                   o.max_iterations);
   HYBRID_VO_FIELDS(non_negative(), o.min_distance_px, o.min_corner_gradient, o.pyramid_levels,
                   o.predicted_pyramid_levels);
+  HYBRID_VO_FIELDS(fraction(), o.redetect_min_missing);
   HYBRID_VO_FIELDS(positive_fraction(), o.quality_level);
   HYBRID_VO_FIELDS(at_least(5), o.window_px);  // smaller windows lose the texture
   HYBRID_VO_FIELDS(any_value(), o.predict_motion, o.drop_leaving);
@@ -108,6 +112,10 @@ class KltTracker {
   void detect_cell(KltDetection* detection, int cell) const;
   void add_detections(const KltDetection& detection);
   void reset();
+  // The point budget and the re-detection's threshold from the next frame on (a CPU budget's
+  // work level); the options' own threshold otherwise. Tracks beyond a smaller cap leave at the
+  // next re-detection, the youngest first.
+  void set_work(int max_features, double redetect_min_missing);
   int num_tracks() const;
   // Every feature of the last frame (tracked and newly detected) and its id.
   const std::vector<cv::Point2f>& points() const { return points_; }
@@ -130,6 +138,7 @@ class KltTracker {
 
   KltTrackerOptions options_;
   int max_features_;
+  double redetect_min_missing_;
   cv::Size size_;
   std::vector<cv::Mat> previous_;  // image pyramid with derivatives, built once per frame
   std::vector<cv::Point2f> points_;

@@ -29,6 +29,8 @@ struct LineDescriptionOptions {
   // line-matching benchmark (Li et al. 2016, ED segments, two octaves) the plain nearest
   // neighbour was a ground-truth match for 56 % of the groups with bits, 73 % with floats.
   bool float_descriptor = true;
+  // false: the segments are oriented by their gradient but get no descriptor.
+  bool describe = true;
 };
 
 struct LineMatchingOptions {

@@ -71,6 +71,8 @@ class LineTracker {
                              LineTrackingStats* stats = nullptr,
                              const Eigen::Matrix3d& image_motion = Eigen::Matrix3d::Identity());
   void reset();
+  // Re-identification on or off from the next frame on (a CPU budget's work level).
+  void set_reidentify(bool on) { options_.reidentify = on; }
   int num_tracks() const { return static_cast<int>(tracks_.size()); }
 
  private:

@@ -11,6 +11,7 @@
 
 #include "hybrid_vo/frontend/affine_tracking.h"
 #include "hybrid_vo/frontend/frontend.h"
+#include "hybrid_vo/frontend/cpu_budget.h"
 #include "hybrid_vo/frontend/klt_tracker.h"
 #include "hybrid_vo/frontend/line_tracker.h"
 #include "hybrid_vo/frontend/stage_timings.h"
@@ -78,6 +79,9 @@ struct VisualOdometryOptions {
   // off its ground truth: against every two-view estimate the truth turns 0.7 % more about axes
   // tilted by 0.4 degrees (hybrid_vo_bench_frontend --direct-gap).
   double rotation_calibration_sigma = 0.01;
+  // A CPU budget per frame (both threads): the front end drops its least useful work, level by
+  // level (cpu_budget.h), while the recent frames exceed it. Off by default.
+  CpuBudgetOptions budget;
 };
 
 // Its own fields, the KLT tracker's under klt_, the estimator's (with the VP detection in front)
@@ -99,6 +103,7 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(positive(), o.mono_scale);
   visit("stereo_max_depth_baselines", o.stereo_scale.max_depth_baselines, non_negative());
   visit("stereo_offset_calibration", o.stereo_offset.enabled);
+  visit_fields(o.budget, visit);
 }
 
 // Externally detected features of a frame (e.g. from a learned front end); ids link them across
@@ -172,6 +177,8 @@ struct VisualOdometryResult {
   // Wall clock: image to matches, VPs + estimator, the whole frame; and per stage.
   double frontend_ms = 0.0, estimator_ms = 0.0, total_ms = 0.0;
   StageTimings stages;
+  int work_level = 0;               // the frame's work level (cpu_budget.h)
+  double average_cpu_ms = 0.0;      // the budget's average CPU per frame, this one included
 };
 
 // Frame-to-frame visual odometry without ROS: front end (KLT or descriptors for points, LSD+LBD
@@ -255,6 +262,8 @@ class VisualOdometry {
   void start_redetection(Frame& f);   // its cells shared by both threads
   void finish_redetection(Frame& f);
   void match_segments(Frame& f) const;
+  // The work level's options for the trackers and the segments (cpu_budget.h).
+  void apply_work_level(int level);
   // Every feature the KLT tracker holds, by id.
   std::map<int64_t, Eigen::Vector2d> klt_points() const;
 
@@ -316,6 +325,9 @@ class VisualOdometry {
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   PoseCovarianceChain pose_covariance_;
   double last_stamp_ = -1e300;
+  // Kept across reset(): the machine's load does not change with the trajectory.
+  CpuBudget budget_;
+  bool describe_segments_ = true;  // the work level's (LBD descriptors for the segments)
 };
 
 }  // namespace hybrid_vo
