@@ -27,6 +27,7 @@ std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
 }
 
 void VisualOdometry::apply_work_level(int level) {
+  work_level_ = level;
   const KltTrackerOptions& klt = options_.klt;
   const int max_features = options_.features.points.max_features;
   klt_.set_work(level >= 3 ? std::max(1, max_features / 2) : max_features,

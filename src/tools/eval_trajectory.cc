@@ -477,9 +477,10 @@ int main(int argc, char** argv) {
                 gt.size());
     print_map_summary(run.motions);
     std::printf("# per frame (median): front end %.1f ms, estimator %.1f ms, total %.1f ms = %.1f "
-                "frames/s\n",
+                "frames/s; total p95 %.1f ms, max %.1f ms\n",
                 median(frontend), median(estimator), median(total),
-                1000.0 / std::max(1e-3, median(total)));
+                1000.0 / std::max(1e-3, median(total)), evaluation::percentile(total, 0.95),
+                total.empty() ? NAN : *std::max_element(total.begin(), total.end()));
     std::printf("# per stage (median ms): points %.1f, re-detection %.1f, lines %.1f, line "
                 "matching %.1f, VPs %.1f, RANSAC %.1f, stereo %.1f\n",
                 median(points), median(redetect), median(lines), median(line_matching), median(vps),

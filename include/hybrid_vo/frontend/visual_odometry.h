@@ -328,6 +328,7 @@ class VisualOdometry {
   // Kept across reset(): the machine's load does not change with the trajectory.
   CpuBudget budget_;
   bool describe_segments_ = true;  // the work level's (LBD descriptors for the segments)
+  int work_level_ = 0;
 };
 
 }  // namespace hybrid_vo
