@@ -25,6 +25,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "hybrid_vo/frontend/cpu_budget.h"
 #include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/render/sequence.h"
@@ -304,6 +305,37 @@ TEST(FeatureTopics, EstimatorUsesTheGivenFeatures) {
   std::nth_element(rotation_errors.begin(), rotation_errors.begin() + rotation_errors.size() / 2,
                    rotation_errors.end());
   EXPECT_LT(rotation_errors[rotation_errors.size() / 2], 0.5);
+}
+
+// A CPU budget below any frame's cost (node_budget.test: max_cpu_ms 0.5): the node steps down to
+// its lightest work level within a few frames, keeps estimating, and reports the budget, the
+// frames' average CPU and the level in diagnostics.
+TEST(Budget, AnUnmeetableBudgetGivesTheLightestLevelAndStillPoses) {
+  render::SequenceOptions options;
+  options.out_bag = "unused.bag";
+  options.frames = 24;
+  options.width = 480;
+  options.height = 360;
+  options.supersampling = 1;
+  const render::Sequence seq = render::make_sequence(options);
+  NodeHarness h;
+  ASSERT_TRUE(h.wait_for_node());
+  h.spin_for(0.5);
+  for (int i = 0; i < options.frames; ++i) {
+    const ros::Time stamp(1.0 + i / options.rate);
+    const render::RenderedView v = render::render_frame(seq, i);
+    h.left_.publish(image_of(v.image, stamp, "camera_left_optical"));
+    h.left_info_.publish(info_of(seq.camera, stamp, "camera_left_optical"));
+    ASSERT_TRUE(h.wait_for(stamp)) << "no ~relative_pose for frame " << i;
+  }
+  int ok = 0;
+  for (const auto& [stamp, m] : h.motions_) ok += m.status == MotionEstimate::STATUS_OK;
+  EXPECT_GE(ok, options.frames / 2);
+  h.spin_for(1.5);  // a diagnostics message after the last frame
+  const diagnostic_msgs::DiagnosticStatus& d = h.last_odometry_status_;
+  EXPECT_DOUBLE_EQ(diagnostic_value(d, "CPU budget (ms)"), 0.5);
+  EXPECT_GT(diagnostic_value(d, "CPU per frame, recent average (ms)"), 0.5);
+  EXPECT_DOUBLE_EQ(diagnostic_value(d, "work level"), static_cast<double>(kMaxWorkLevel));
 }
 
 // Bad input never crashes the node and shows up in diagnostics; it keeps working afterwards.
