@@ -49,6 +49,7 @@ CASES = {
         "image_transport": ("compressed",
                             lambda c: param(c, "/hybrid_vo/image_transport") == "compressed"),
         "output": ("log", lambda c: node(c, "hybrid_vo").output == "log"),
+        "max_cpu_ms": ("12", lambda c: param(c, "/hybrid_vo/max_cpu_ms") == 12),
     },
 }
 # The replay launch files share their arguments; lamar adds its cameras.
@@ -62,6 +63,7 @@ REPLAY = {
     "image_transport": ("compressed",
                         lambda c: param(c, "/hybrid_vo/image_transport") == "compressed"),
     "config": (LOW_TEXTURE, lambda c: param(c, "/hybrid_vo/klt_min_corner_gradient") == 1.5),
+    "max_cpu_ms": ("12", lambda c: param(c, "/hybrid_vo/max_cpu_ms") == 12),
     "play": ("false", lambda c: not [n for n in c.nodes if n.name == "player"]
              and param(c, "/use_sim_time") is False),
 }
