@@ -51,7 +51,7 @@ TEST(CpuBudget, ItSettlesWhereTheLevelFitsAndStepsBackWhenTheLoadGoes) {
   CpuBudgetOptions options;
   options.max_cpu_ms = 20.0;
   CpuBudget budget(options);
-  // Each level costs what the controller expects of it: 30 ms at level 0, 22.5 at 1, 19.1 at 2.
+  // Each level costs what the controller expects of it, 30 ms with all the work.
   auto cost = [](double full) {
     return [full](int level) {
       double c = full;
@@ -59,12 +59,14 @@ TEST(CpuBudget, ItSettlesWhereTheLevelFitsAndStepsBackWhenTheLoadGoes) {
       return c;
     };
   };
-  EXPECT_EQ(feed(&budget, 200, cost(30.0)), 2);
-  // The load goes (a third less): level 1 fits with the margin (15 < 0.85 * 20), level 0 does not.
-  EXPECT_EQ(feed(&budget, 200, cost(20.0)), 1);
-  // Much less: all the work again, and it stays there.
-  EXPECT_EQ(feed(&budget, 200, cost(8.0)), 0);
-  EXPECT_EQ(feed(&budget, 200, cost(8.0)), 0);
+  int fits = 0;  // the first level within the budget
+  while (fits < kMaxWorkLevel && cost(30.0)(fits) > options.max_cpu_ms) ++fits;
+  ASSERT_GT(fits, 1);
+  EXPECT_EQ(feed(&budget, 200, cost(30.0)), fits);
+  EXPECT_EQ(feed(&budget, 200, cost(30.0)), fits);  // and stays there
+  // The load goes (a quarter of it is left): all the work again, and it stays there.
+  EXPECT_EQ(feed(&budget, 400, cost(7.5)), 0);
+  EXPECT_EQ(feed(&budget, 200, cost(7.5)), 0);
 }
 
 TEST(CpuBudget, TimesThatAreNotFiniteOrNegativeAreIgnored) {

@@ -86,6 +86,7 @@ std::vector<Case> every_parameter() {
       {"opencv_threads", -1, [](P p) { return p.opencv_threads == -1; }},
       {"klt_predict_motion", false, [](P p) { return !p.odometry.klt.predict_motion; }},
       {"klt_window_px", 21, [](P p) { return p.odometry.klt.window_px == 21; }},
+      {"klt_redetect_alternate", true, [](P p) { return p.odometry.klt.redetect_alternate; }},
       {"klt_min_corner_gradient", 1.5,
        [](P p) { return p.odometry.klt.min_corner_gradient == 1.5; }},
       {"point_threshold_px", 2.0,

@@ -486,6 +486,47 @@ bool same_tracker(const KltTracker& a, const KltTracker& b) {
 // Issue 32: the searches and the re-detection's cells split over threads (here: backwards, and
 // on a worker thread beside this one) give the tracks of the sequential tracker, also when
 // max_features leaves less room than the empty cells want.
+// redetect_alternate (the CPU budget's first level): after the first frame, which fills every
+// cell, each re-detection looks in one colour of a checkerboard of the grid's cells, the other
+// colour the next time; and a reset starts with every cell again.
+TEST(KltTracker, AlternateRedetectionFillsHalfTheCellsByTurns) {
+  const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1000, 2.5);
+  auto frame = [&](int k) {  // a pan: features leave on one side, cells empty on the other
+    const cv::Matx23d warp(1, 0, -150 + 12.0 * k, 0, 1, -100);
+    cv::Mat image;
+    cv::warpAffine(texture, image, warp, cv::Size(640, 480),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+    return image;
+  };
+  KltTrackerOptions options;
+  options.redetect_alternate = true;
+  KltTracker tracker(options, 600);
+  int previous_colour = -1;
+  for (int k = 0; k < 6; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    tracker.track_existing(frame(k), nullptr, 0.1 * k);
+    KltDetection d = tracker.plan_detection();
+    int wanting[2] = {0, 0};  // cells wanting corners, by checkerboard colour
+    for (int c = 0; c < d.cells(); ++c)
+      if (d.wanted[c] > 0) ++wanting[(c % d.cols + c / d.cols) % 2];
+    if (k == 0) {
+      EXPECT_EQ(wanting[0] + wanting[1], d.cells());  // nothing tracked yet: every cell
+    } else {
+      ASSERT_TRUE((wanting[0] > 0) != (wanting[1] > 0)) << wanting[0] << " " << wanting[1];
+      const int colour = wanting[0] > 0 ? 0 : 1;
+      if (previous_colour >= 0) EXPECT_NE(colour, previous_colour);
+      previous_colour = colour;
+    }
+    for (int c = 0; c < d.cells(); ++c) tracker.detect_cell(&d, c);
+    tracker.add_detections(d);
+  }
+  tracker.reset();
+  tracker.track_existing(frame(0), nullptr, 0.0);
+  const KltDetection d = tracker.plan_detection();
+  EXPECT_EQ(std::count_if(d.wanted.begin(), d.wanted.end(), [](int w) { return w > 0; }),
+            d.cells());
+}
+
 TEST(KltTracker, SplitSearchesAndCellsGiveTheSameTracks) {
   const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1000, 2.5);
   // Zooming in about a point left of centre: the flow differs across the image and features

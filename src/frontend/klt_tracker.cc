@@ -61,11 +61,13 @@ double corner_gradient(const cv::Mat& gray, const cv::Point2f& p, int window) {
 KltTracker::KltTracker(const KltTrackerOptions& options, int max_features)
     : options_(options),
       max_features_(max_features),
-      redetect_min_missing_(options.redetect_min_missing) {}
+      redetect_min_missing_(options.redetect_min_missing),
+      redetect_alternate_(options.redetect_alternate) {}
 
-void KltTracker::set_work(int max_features, double redetect_min_missing) {
+void KltTracker::set_work(int max_features, double redetect_min_missing, bool redetect_alternate) {
   max_features_ = std::max(1, max_features);
   redetect_min_missing_ = std::clamp(redetect_min_missing, 0.0, 1.0);
+  redetect_alternate_ = redetect_alternate;
 }
 
 void KltTracker::reset() {
@@ -75,6 +77,7 @@ void KltTracker::reset() {
   motion_.clear();
   ids_.clear();
   stamp_ = motion_dt_ = kNoStamp;
+  detections_ = 0;
 }
 
 int KltTracker::num_tracks() const { return static_cast<int>(points_.size()); }
@@ -276,9 +279,12 @@ KltDetection KltTracker::plan_detection() const {
   }
   d.wanted.resize(d.cells());
   const int min_missing = static_cast<int>(std::ceil(redetect_min_missing_ * quota));
+  const bool alternate = redetect_alternate_ && !points_.empty();
   for (int c = 0; c < d.cells(); ++c) {
     d.wanted[c] = quota - count[c];
     if (d.wanted[c] < min_missing) d.wanted[c] = 0;
+    const int cx = c % cols, cy = c / cols;
+    if (alternate && (cx + cy + detections_) % 2 != 0) d.wanted[c] = 0;
   }
   d.corners.resize(d.cells());
   d.strong.resize(d.cells());
@@ -308,6 +314,7 @@ void KltTracker::detect_cell(KltDetection* d, int c) const {
 }
 
 void KltTracker::add_detections(const KltDetection& d) {
+  ++detections_;
   const int max_features = std::max(1, max_features_);
   for (int c = 0; c < d.cells() && c < static_cast<int>(d.corners.size()); ++c) {
     const int room = max_features - static_cast<int>(points_.size());

@@ -38,7 +38,7 @@ bool VisualOdometry::estimate(Frame& f) {
   TwoViewOptions estimator = options_.estimator;
   // Half the features, half the independent ones: a pair's points are as correlated as before
   // (cpu_budget.h), and counting them as many would make its covariance claim too much.
-  if (work_level_ >= 3) estimator.covariance.independent_points *= 0.5;
+  if (work_level_ >= 4) estimator.covariance.independent_points *= 0.5;
   const auto vps_start = std::chrono::steady_clock::now();
   if (uses_vps(estimator) && !m.lines.empty()) {
     VpDetectionOptions vp_options = estimator.vp_detection;

@@ -30,10 +30,11 @@ void VisualOdometry::apply_work_level(int level) {
   work_level_ = level;
   const KltTrackerOptions& klt = options_.klt;
   const int max_features = options_.features.points.max_features;
-  klt_.set_work(level >= 3 ? std::max(1, max_features / 2) : max_features,
-                level >= 1 ? std::max(0.5, klt.redetect_min_missing) : klt.redetect_min_missing);
-  line_tracker_.set_reidentify(level < 1 && options_.line_tracking.reidentify);
-  describe_segments_ = level < 2 && options_.features.lines.description.describe;
+  klt_.set_work(level >= 4 ? std::max(1, max_features / 2) : max_features,
+                level >= 2 ? std::max(0.5, klt.redetect_min_missing) : klt.redetect_min_missing,
+                level >= 1 || klt.redetect_alternate);
+  line_tracker_.set_reidentify(level < 2 && options_.line_tracking.reidentify);
+  describe_segments_ = level < 3 && options_.features.lines.description.describe;
 }
 
 void VisualOdometry::track_segments(Frame& f) {

@@ -134,6 +134,7 @@ const std::vector<Parameter>& parameters() {
       field<int>("opencv_threads", NODE_FIELD(int, opencv_threads)),
       field<bool>("klt_predict_motion", NODE_FIELD(bool, odometry.klt.predict_motion)),
       field<int>("klt_window_px", NODE_FIELD(int, odometry.klt.window_px)),
+      field<bool>("klt_redetect_alternate", NODE_FIELD(bool, odometry.klt.redetect_alternate)),
       field<double>("klt_min_corner_gradient",
                     NODE_FIELD(double, odometry.klt.min_corner_gradient)),
       field<double>("point_threshold_px",

@@ -44,7 +44,7 @@ void usage(const char* program) {
                " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
-               " [--max-features N] [--verbose]\n"
+               " [--max-features N] [--redetect-alternate] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
@@ -71,8 +71,10 @@ void usage(const char* program) {
                "  --truth-direction-sigma-deg and --truth-orientation-sigma-deg add the truth's\n"
                "  own noise (degrees per axis) as there.\n"
                "  --max-cpu-ms B: the node's max_cpu_ms, a CPU budget per frame (both threads);\n"
-               "  --work-level L: its min_work_level, a fixed level 0-3 (cpu_budget.h);\n"
-               "  --max-features N: the point budget (default 1500, as config/kitti.yaml).\n";
+               "  --work-level L: its min_work_level, a fixed level 0-4 (cpu_budget.h);\n"
+               "  --max-features N: the point budget (default 1500, as config/kitti.yaml);\n"
+               "  --redetect-alternate: KLT re-detection in half the cells per frame, taking\n"
+               "  turns (klt_redetect_alternate: true).\n";
 }
 
 // The median of each coordinate.
@@ -172,6 +174,7 @@ int run(int argc, char** argv) {
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--drop-leaving") o.klt.drop_leaving = true;
+    else if (a == "--redetect-alternate") o.klt.redetect_alternate = true;
     else if (a == "--max-cpu-ms" && i + 1 < argc) o.budget.max_cpu_ms = std::atof(argv[++i]);
     else if (a == "--work-level" && i + 1 < argc) o.budget.min_work_level = std::atoi(argv[++i]);
     else if (a == "--stereo") stereo = true;
@@ -511,8 +514,8 @@ int run(int argc, char** argv) {
   // its longer thread's CPU time.
   std::printf("CPU ms per frame (median) by thread: calling %.1f, worker %.1f, the longer %.1f\n",
               median(caller_cpu), median(worker_cpu), median(longest_cpu));
-  std::printf("CPU per frame: p95 %.1f ms; budget %.1f ms (0: none); frames at work level 0/1/2/3:",
-              percentile(cpu, 0.95), o.budget.max_cpu_ms);
+  std::printf("CPU per frame: p95 %.1f ms; budget %.1f ms (0: none); frames at work level 0..%d:",
+              percentile(cpu, 0.95), o.budget.max_cpu_ms, kMaxWorkLevel);
   for (int n : frames_at_level) std::printf(" %d", n);
   std::printf("\n");
   if (stereo) {

@@ -10,11 +10,12 @@ namespace hybrid_vo {
 // below it, the work that bought the least accuracy per millisecond on the evaluation sets
 // (doc/performance.md, "A CPU budget"):
 //   0 everything;
-//   1 a KLT grid cell is re-detected only once it misses half its quota, and lost segment tracks
+//   1 KLT re-detection in half the grid's cells per frame, taking turns (redetect_alternate);
+//   2 a KLT grid cell is re-detected only once it misses half its quota, and lost segment tracks
 //     are not re-identified by their descriptors;
-//   2 segments get no LBD descriptor (a track with two parallel candidates is left unmatched);
-//   3 half the point features.
-constexpr int kMaxWorkLevel = 3;
+//   3 segments get no LBD descriptor (a track with two parallel candidates is left unmatched);
+//   4 half the point features.
+constexpr int kMaxWorkLevel = 4;
 
 struct CpuBudgetOptions {
   // CPU milliseconds per frame, both threads added; 0: no budget (the level stays at
@@ -38,7 +39,8 @@ class CpuBudget {
  public:
   // What a level costs against the one below it, measured on the evaluation sets; the
   // prediction of the level below is the average divided by it.
-  static constexpr std::array<double, kMaxWorkLevel + 1> kCostRatio = {1.0, 0.75, 0.85, 0.70};
+  static constexpr std::array<double, kMaxWorkLevel + 1> kCostRatio = {1.0, 0.80, 0.85, 0.85,
+                                                                        0.75};
   static constexpr int kSettleFrames = 5;    // frames after a step before the next one up
   static constexpr int kStepDownFrames = 30;  // frames the level below must fit before a step down
   static constexpr double kStepDownMargin = 0.85;  // of the budget, for the level below
