@@ -56,7 +56,7 @@ struct KltTrackerOptions {
   // Re-detection in half the grid's cells per frame, as on a checkerboard whose colours take
   // turns: each cell is refilled every other frame. Most new corners die at their first track
   // (51-70 % on the evaluation sets), so refilling every frame mostly feeds the forward-backward
-  // check; every other frame costs 11-24 % less CPU and is as accurate or more on 10 of 13 sets
+  // check; every other frame costs 13-25 % less CPU and is as accurate or more on 9 of 13 sets
   // (KITTI AUC@10 -0.07), but the stereo scale's affine refinement and the pairs' honesty on the
   // rendered corridor move (doc/performance.md#a-cpu-budget-issue-44): the CPU budget's first
   // level, not yet the default.
