@@ -28,10 +28,22 @@
 
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/render/camera_path.h"
+#include "hybrid_vo/render/sequence.h"
 #include "ros_connections.h"
 
 namespace hybrid_vo {
 namespace testing {
+
+// A short rendered corridor at one sample per pixel, for scenarios that need frames, not detail.
+inline render::SequenceOptions small_sequence_options(int frames, int width, int height) {
+  render::SequenceOptions options;
+  options.out_bag = "unused.bag";
+  options.frames = frames;
+  options.width = width;
+  options.height = height;
+  options.supersampling = 1;
+  return options;
+}
 
 inline sensor_msgs::CameraInfo info_of(const PinholeCamera& c, const ros::Time& stamp,
                                 const std::string& frame, double tx = 0.0) {

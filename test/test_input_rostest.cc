@@ -33,6 +33,7 @@ namespace {
 
 using testing::image_of;
 using testing::info_of;
+using testing::small_sequence_options;
 
 constexpr double kDeg = 180.0 / M_PI;
 
@@ -464,12 +465,7 @@ TEST(Fisheye, RectifiedFisheyeTracksAsWellAsThePinhole) {
 // distortion model nobody knows: each frame is counted as invalid camera_info, named in the
 // diagnostics and skipped; the node goes on with the next good frames.
 TEST(Fisheye, BadCameraInfoIsCountedAndSkipped) {
-  render::SequenceOptions options;
-  options.out_bag = "unused.bag";
-  options.frames = 7;
-  options.width = 320;
-  options.height = 240;
-  options.supersampling = 1;
+  render::SequenceOptions options = small_sequence_options(7, 320, 240);
   options.fisheye_fov = 150.0;
   const render::Sequence seq = render::make_sequence(options);
   Nodes nodes({"fisheye"});

@@ -40,6 +40,7 @@ using testing::image_of;
 using testing::info_of;
 using testing::NodeHarness;
 using testing::publish_static_camera;
+using testing::small_sequence_options;
 using testing::unknown;
 
 constexpr double kDeg = 180.0 / M_PI;
@@ -311,12 +312,7 @@ TEST(FeatureTopics, EstimatorUsesTheGivenFeatures) {
 // its lightest work level within a few frames, keeps estimating, and reports the budget, the
 // frames' average CPU and the level in diagnostics.
 TEST(Budget, AnUnmeetableBudgetGivesTheLightestLevelAndStillPoses) {
-  render::SequenceOptions options;
-  options.out_bag = "unused.bag";
-  options.frames = 24;
-  options.width = 480;
-  options.height = 360;
-  options.supersampling = 1;
+  const render::SequenceOptions options = small_sequence_options(24, 480, 360);
   const render::Sequence seq = render::make_sequence(options);
   NodeHarness h;
   ASSERT_TRUE(h.wait_for_node());
@@ -340,12 +336,7 @@ TEST(Budget, AnUnmeetableBudgetGivesTheLightestLevelAndStillPoses) {
 
 // Bad input never crashes the node and shows up in diagnostics; it keeps working afterwards.
 TEST(BadInput, DiagnosticsAndRecovery) {
-  render::SequenceOptions options;
-  options.out_bag = "unused.bag";
-  options.frames = 12;
-  options.width = 320;
-  options.height = 240;
-  options.supersampling = 1;
+  const render::SequenceOptions options = small_sequence_options(12, 320, 240);
   const render::Sequence seq = render::make_sequence(options);
   NodeHarness h;
   ASSERT_TRUE(h.wait_for_node());

@@ -59,15 +59,12 @@ double corner_gradient(const cv::Mat& gray, const cv::Point2f& p, int window) {
 }  // namespace
 
 KltTracker::KltTracker(const KltTrackerOptions& options, int max_features)
-    : options_(options),
-      max_features_(max_features),
-      redetect_min_missing_(options.redetect_min_missing),
-      redetect_alternate_(options.redetect_alternate) {}
+    : options_(options), max_features_(max_features) {}
 
 void KltTracker::set_work(int max_features, double redetect_min_missing, bool redetect_alternate) {
   max_features_ = std::max(1, max_features);
-  redetect_min_missing_ = std::clamp(redetect_min_missing, 0.0, 1.0);
-  redetect_alternate_ = redetect_alternate;
+  options_.redetect_min_missing = std::clamp(redetect_min_missing, 0.0, 1.0);
+  options_.redetect_alternate = redetect_alternate;
 }
 
 void KltTracker::reset() {
@@ -278,8 +275,8 @@ KltDetection KltTracker::plan_detection() const {
     cv::circle(d.mask, p, static_cast<int>(options_.min_distance_px), cv::Scalar(0), cv::FILLED);
   }
   d.wanted.resize(d.cells());
-  const int min_missing = static_cast<int>(std::ceil(redetect_min_missing_ * quota));
-  const bool alternate = redetect_alternate_ && !points_.empty();
+  const int min_missing = static_cast<int>(std::ceil(options_.redetect_min_missing * quota));
+  const bool alternate = options_.redetect_alternate && !points_.empty();
   for (int c = 0; c < d.cells(); ++c) {
     d.wanted[c] = quota - count[c];
     if (d.wanted[c] < min_missing) d.wanted[c] = 0;

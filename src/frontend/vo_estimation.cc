@@ -36,9 +36,10 @@ bool VisualOdometry::estimate(Frame& f) {
     if (!lines_done) std::swap(distorted.lines, m.lines);
   }
   TwoViewOptions estimator = options_.estimator;
-  // Half the features, half the independent ones: a pair's points are as correlated as before
-  // (cpu_budget.h), and counting them as many would make its covariance claim too much.
-  if (work_level_ >= 4) estimator.covariance.independent_points *= 0.5;
+  // A share of the point budget, that share of the independent points: a pair's points are as
+  // correlated as before (cpu_budget.h), and counting them as many would make its covariance
+  // claim too much.
+  estimator.covariance.independent_points *= point_share_;
   const auto vps_start = std::chrono::steady_clock::now();
   if (uses_vps(estimator) && !m.lines.empty()) {
     VpDetectionOptions vp_options = estimator.vp_detection;

@@ -27,21 +27,22 @@ std::map<int64_t, Eigen::Vector2d> VisualOdometry::klt_points() const {
 }
 
 void VisualOdometry::apply_work_level(int level) {
-  work_level_ = level;
   const KltTrackerOptions& klt = options_.klt;
+  point_share_ = level >= 4 ? 0.5 : 1.0;
   const int max_features = options_.features.points.max_features;
-  klt_.set_work(level >= 4 ? std::max(1, max_features / 2) : max_features,
+  klt_.set_work(std::max(1, static_cast<int>(point_share_ * max_features)),
                 level >= 2 ? std::max(0.5, klt.redetect_min_missing) : klt.redetect_min_missing,
                 level >= 1 || klt.redetect_alternate);
   line_tracker_.set_reidentify(level < 2 && options_.line_tracking.reidentify);
-  describe_segments_ = level < 3 && options_.features.lines.description.describe;
+  // Without segment tracking the descriptors are what matches the segments: they stay.
+  segment_options_ = options_.features.lines;
+  segment_options_.description.describe =
+      (level < 3 || !options_.track_lines) && segment_options_.description.describe;
 }
 
 void VisualOdometry::track_segments(Frame& f) {
   const auto lines_start = std::chrono::steady_clock::now();
-  LineMatchingOptions lines = options_.features.lines;
-  lines.description.describe = describe_segments_;
-  f.features.lines = detect_line_features(f.gray, lines);
+  f.features.lines = detect_line_features(f.gray, segment_options_);
   if (options_.track_lines)
     f.line_ids = line_tracker_.track(f.features.lines, f.input.stamp, &f.result.line_tracking,
                                      f.segment_motion);

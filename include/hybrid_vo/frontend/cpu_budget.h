@@ -13,7 +13,8 @@ namespace hybrid_vo {
 //   1 KLT re-detection in half the grid's cells per frame, taking turns (redetect_alternate);
 //   2 a KLT grid cell is re-detected only once it misses half its quota, and lost segment tracks
 //     are not re-identified by their descriptors;
-//   3 segments get no LBD descriptor (a track with two parallel candidates is left unmatched);
+//   3 segments get no LBD descriptor (a track with two parallel candidates is left unmatched;
+//     without segment tracking they keep them: they are what matches the segments);
 //   4 half the point features.
 constexpr int kMaxWorkLevel = 4;
 

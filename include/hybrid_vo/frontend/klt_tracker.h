@@ -147,8 +147,6 @@ class KltTracker {
   KltTrackerOptions options_;
   int max_features_;
   int64_t detections_ = 0;  // re-detections added since the last reset (redetect_alternate)
-  double redetect_min_missing_;
-  bool redetect_alternate_;
   cv::Size size_;
   std::vector<cv::Mat> previous_;  // image pyramid with derivatives, built once per frame
   std::vector<cv::Point2f> points_;

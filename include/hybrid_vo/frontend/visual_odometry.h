@@ -327,8 +327,10 @@ class VisualOdometry {
   double last_stamp_ = -1e300;
   // Kept across reset(): the machine's load does not change with the trajectory.
   CpuBudget budget_;
-  bool describe_segments_ = true;  // the work level's (LBD descriptors for the segments)
-  int work_level_ = 0;
+  // The work level's (apply_work_level): the segments' detection and description, and the share
+  // of the point budget the KLT tracker keeps.
+  LineMatchingOptions segment_options_;
+  double point_share_ = 1.0;
 };
 
 }  // namespace hybrid_vo
