@@ -98,6 +98,13 @@ double direction_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_tru
   return nees<2>(e, C);
 }
 
+double translation_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_true,
+                        const Eigen::Matrix3d& covariance, double truth_sigma) {
+  if (!t_est.allFinite() || !t_true.allFinite() || !usable_covariance(covariance, 3)) return NAN;
+  return nees<3>(Eigen::Vector3d(t_est - t_true),
+                 covariance + truth_sigma * truth_sigma * Eigen::Matrix3d::Identity());
+}
+
 RelativeOrientation relative_orientation(const Eigen::Matrix3d& R0_est,
                                          const Eigen::Matrix3d& Rk_est,
                                          const Eigen::Matrix3d& R0_true,

@@ -44,6 +44,11 @@ double rotation_nees(const Eigen::Matrix3d& R_est, const Eigen::Matrix3d& R_true
 double direction_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_true,
                       const Eigen::Matrix3d& covariance, double truth_sigma = 0.0);
 
+// NEES of a metric translation (3 dof; stereo pairs): the error t_est - t_true under covariance
+// + truth_sigma^2 I (metres). NaN when the covariance is not usable with full rank.
+double translation_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_true,
+                        const Eigen::Matrix3d& covariance, double truth_sigma = 0.0);
+
 // Camera k's orientation against the first camera's, as the trajectory tools compare it:
 // error = log(R_est_rel R_true_rel^T) with R_rel = R_0^T R_k (camera-to-world rotations). Its
 // covariance comes from `covariance_world`, that of a left increment of the estimated R_k about
