@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "painter.h"
+#include "route.h"
 
 namespace hybrid_vo {
 namespace render {
@@ -14,84 +15,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
-
-// One piece of the rounded route: a straight line, or a quarter circle around `centre`.
-struct Piece {
-  bool arc = false;
-  Eigen::Vector2d start = Eigen::Vector2d::Zero(), dir = Eigen::Vector2d::Zero();  // line
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();                                // arc
-  Eigen::Vector2d d_in = Eigen::Vector2d::Zero(), d_out = Eigen::Vector2d::Zero();
-  double radius = 0.0, length = 0.0;
-};
-
-std::vector<Piece> route_pieces(const Scene& scene) {
-  const std::vector<Eigen::Vector2d>& p = scene.route;
-  const int n = static_cast<int>(p.size());
-  if (n < 3) throw std::invalid_argument("render path: the scene has no route");
-  const double r = scene.route_corner_radius;
-  std::vector<double> trim(n, 0.0);
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector2d d_in = (p[i] - p[(i + n - 1) % n]).normalized();
-    const Eigen::Vector2d d_out = (p[(i + 1) % n] - p[i]).normalized();
-    const double turn = d_in.x() * d_out.y() - d_in.y() * d_out.x();
-    if (std::abs(turn) > 1e-9) {
-      if (std::abs(d_in.dot(d_out)) > 1e-9)
-        throw std::invalid_argument("render path: route corners must be right angles");
-      trim[i] = r;
-    }
-  }
-  std::vector<Piece> pieces;
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    const Eigen::Vector2d d = (p[j] - p[i]).normalized();
-    Piece line;
-    line.start = p[i] + trim[i] * d;
-    line.dir = d;
-    line.length = (p[j] - p[i]).norm() - trim[i] - trim[j];
-    if (line.length < 0.0) throw std::invalid_argument("render path: route edge too short");
-    pieces.push_back(line);
-    if (trim[j] > 0.0) {
-      Piece arc;
-      arc.arc = true;
-      arc.d_in = d;
-      arc.d_out = (p[(j + 1) % n] - p[j]).normalized();
-      arc.radius = r;
-      arc.centre = p[j] - r * arc.d_in + r * arc.d_out;
-      arc.length = 0.5 * kPi * r;
-      pieces.push_back(arc);
-    }
-  }
-  return pieces;
-}
-
-// Position and unit tangent at arc length s (wrapped onto the loop).
-void evaluate(const std::vector<Piece>& pieces, double total, double s, Eigen::Vector2d* pos,
-              Eigen::Vector2d* tangent) {
-  s = std::fmod(s, total);
-  if (s < 0.0) s += total;
-  for (const Piece& piece : pieces) {
-    if (s > piece.length && &piece != &pieces.back()) {
-      s -= piece.length;
-      continue;
-    }
-    s = std::min(s, piece.length);
-    if (!piece.arc) {
-      *pos = piece.start + s * piece.dir;
-      *tangent = piece.dir;
-    } else {
-      const double t = s / piece.radius;
-      *pos = piece.centre + piece.radius * (-piece.d_out * std::cos(t) + piece.d_in * std::sin(t));
-      *tangent = piece.d_out * std::sin(t) + piece.d_in * std::cos(t);
-    }
-    return;
-  }
-}
-
-double total_length(const std::vector<Piece>& pieces) {
-  double total = 0.0;
-  for (const Piece& piece : pieces) total += piece.length;
-  return total;
-}
 
 void check(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("render path: " + what);
@@ -112,7 +35,7 @@ CameraPose stereo_right(const CameraPose& left, double baseline) {
   return right;
 }
 
-double route_length(const Scene& scene) { return total_length(route_pieces(scene)); }
+double route_length(const Scene& scene) { return route_length(route_pieces(scene)); }
 
 Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
   check(o.num_frames >= 1 && o.num_frames <= 1000000, "num_frames must be in [1, 1e6]");
@@ -126,8 +49,8 @@ Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
   check(std::isfinite(o.pitch_down_deg) && std::abs(o.pitch_down_deg) <= 30.0,
         "pitch must be within +-30 degrees");
 
-  const std::vector<Piece> pieces = route_pieces(scene);
-  const double total = total_length(pieces);
+  const std::vector<RoutePiece> pieces = route_pieces(scene);
+  const double total = route_length(pieces);
   Rng rng(hash_mix(o.seed, 0x9A7B));
   double phase[6];
   for (double& p : phase) p = rng.uniform(0.0, 2.0 * kPi);
@@ -140,13 +63,13 @@ Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
     const double time = i / o.rate_hz;
     const double s = o.start + o.speed * time;
     Eigen::Vector2d pos = Eigen::Vector2d::Zero(), tangent = Eigen::Vector2d::UnitX();
-    evaluate(pieces, total, s, &pos, &tangent);
+    point_on_route(pieces, total, s, &pos, &tangent);
     // Heading: the tangent averaged with triangular weights over +-2 m, so that the yaw rate
     // ramps up and down smoothly and a 90-degree turn takes about 4 m (peak 50 deg/s at 1.5 m/s).
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (int k = -20; k <= 20; ++k) {
       Eigen::Vector2d p2 = Eigen::Vector2d::Zero(), t2 = Eigen::Vector2d::Zero();
-      evaluate(pieces, total, s + 0.1 * k, &p2, &t2);
+      point_on_route(pieces, total, s + 0.1 * k, &p2, &t2);
       mean += (21 - std::abs(k)) * t2;
     }
     const double heading = std::atan2(mean.y(), mean.x());
