@@ -63,6 +63,18 @@ std::string sequence_usage(const std::string& program) {
     << "                     (low texture: only the edges of walls, boxes, doors, floor joints)\n"
     << "  --baseline M       stereo baseline in metres (default 0.12)\n"
     << "  --speed M_PER_S    walking speed (default 1.5)\n"
+    << "  --motion walk|rest|turn|ramp  how the camera moves (default walk): walk along the\n"
+    << "                     route; rest: stand still at its start (only the noise changes);\n"
+    << "                     turn: turn in place there like a wheeled robot; ramp: rest, then\n"
+    << "                     start walking\n"
+    << "  --lever-arm M      turn: the vertical axis this far behind the camera (default 0.2;\n"
+    << "                     0: about the camera centre)\n"
+    << "  --turn-rate DEG_S  turn: the yaw rate after a smooth 1 s ramp (default 30; negative:\n"
+    << "                     to the right)\n"
+    << "  --turn-stop        turn: ramp down to rest over the last second\n"
+    << "  --rest-seconds S   ramp: still for S seconds first (default 1)\n"
+    << "  --ramp-seconds S   ramp: then accelerating smoothly to --speed over S seconds\n"
+    << "                     (default 2); the walker's sway grows with the speed\n"
     << "  --focal PX         focal length (default 0.72 * width)\n"
     << "  --fisheye-fov DEG  an equidistant (fisheye) lens of this horizontal field of view\n"
     << "                     instead of the pinhole (camera_info distortion_model equidistant)\n"
@@ -79,6 +91,7 @@ std::string sequence_usage(const std::string& program) {
 }
 
 std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOptions* o) {
+  std::vector<std::string> motion_options;  // given, to check against the motion at the end
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg == "--help" || arg == "-h") {
@@ -89,12 +102,19 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       o->stereo = true;
       continue;
     }
+    if (arg == "--turn-stop") {
+      o->turn_stop = true;
+      motion_options.push_back(arg);
+      continue;
+    }
     static const char* kValued[] = {"--out",           "--png-dir",    "--frames", "--width",
                                     "--height",        "--rate",       "--seed",   "--scene",
                                     "--baseline",      "--speed",      "--focal",  "--noise",
                                     "--supersampling", "--compression", "--laps",
                                     "--texture",       "--kitti-dir",   "--kitti-name",
-                                    "--compressed",    "--jpeg-quality", "--fisheye-fov"};
+                                    "--compressed",    "--jpeg-quality", "--fisheye-fov",
+                                    "--motion",        "--lever-arm",    "--turn-rate",
+                                    "--rest-seconds",  "--ramp-seconds"};
     bool known = false;
     for (const char* name : kValued) known = known || arg == name;
     if (!known) return "unknown argument '" + arg + "'";
@@ -149,7 +169,20 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       ok = parse_double(v, 0.0, 200.0, true, &o->fisheye_fov);
     } else if (arg == "--jpeg-quality") {
       ok = parse_int(v, 1, 100, &o->jpeg_quality);
+    } else if (arg == "--motion") {
+      ok = parse_motion(v, &o->motion);
+    } else if (arg == "--lever-arm") {
+      ok = parse_double(v, 0.0, 2.0, false, &o->lever_arm);
+    } else if (arg == "--turn-rate") {
+      ok = parse_double(v, -360.0, 360.0, false, &o->turn_rate);
+    } else if (arg == "--rest-seconds") {
+      ok = parse_double(v, 0.0, 3600.0, false, &o->rest_seconds);
+    } else if (arg == "--ramp-seconds") {
+      ok = parse_double(v, 0.0, 600.0, false, &o->ramp_seconds);
     }
+    if (arg == "--lever-arm" || arg == "--turn-rate" || arg == "--rest-seconds" ||
+        arg == "--ramp-seconds")
+      motion_options.push_back(arg);
     if (!ok) return "bad value '" + v + "' for " + arg;
   }
   if (o->out_bag.empty() && o->kitti_dir.empty())
@@ -158,6 +191,15 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     return "--focal and --fisheye-fov exclude each other (the field of view sets the focal)";
   if (!o->kitti_dir.empty() && o->fisheye_fov > 0.0)
     return "--kitti-dir writes a pinhole calib.txt: not with --fisheye-fov";
+  for (const std::string& option : motion_options) {
+    const Motion needs = option == "--rest-seconds" || option == "--ramp-seconds" ? Motion::kRamp
+                                                                                 : Motion::kTurn;
+    if (o->motion != needs)
+      return option + " is an option of --motion " + to_string(needs) + ", not " +
+             to_string(o->motion);
+  }
+  if (o->laps > 0.0 && o->motion != Motion::kWalk)
+    return std::string("--laps measures a walk: not with --motion ") + to_string(o->motion);
   return "";
 }
 
@@ -199,6 +241,12 @@ Sequence make_sequence(const SequenceOptions& options) {
   path.rate_hz = options.rate;
   path.speed = options.speed;
   path.seed = options.seed;
+  path.motion = options.motion;
+  path.lever_arm = options.lever_arm;
+  path.turn_rate_deg = options.turn_rate;
+  path.turn_stop = options.turn_stop;
+  path.rest_seconds = options.rest_seconds;
+  path.ramp_seconds = options.ramp_seconds;
   seq.trajectory = make_trajectory(seq.scene, path);
   seq.camera = default_camera(options.width, options.height);
   if (options.focal > 0.0) seq.camera.fx = seq.camera.fy = options.focal;
