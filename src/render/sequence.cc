@@ -16,7 +16,8 @@ namespace render {
 std::string sequence_usage(const std::string& program) {
   std::ostringstream s;
   s << "Usage: " << program << " --out OUT.bag | --kitti-dir DIR [options]\n"
-    << "Renders a synthetic Manhattan sequence (textured corridor or room, a walk with turns)\n"
+    << "Renders a synthetic Manhattan sequence (textured corridor or room, a walk with turns,\n"
+    << "or standing, turning in place, starting from rest: --motion)\n"
     << "into a bag: /camera/left/{image_raw,camera_info} (and /camera/right/... with --stereo),\n"
     << "/ground_truth/pose, /tf (world -> gt_camera_left_optical) and /tf_static; and/or into\n"
     << "the KITTI odometry layout.\n"
