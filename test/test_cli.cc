@@ -262,6 +262,50 @@ TEST(BenchFrontendCli, BadTruthSigma) {
                    std::string(option) + ": expected a number of degrees >= 0");
 }
 
+// hybrid_vo_render_pan with doc/rviz_demo.png (1600 x 900) as the photograph.
+TEST(RenderPanCli, BadInputsAreNamed) {
+  const std::string out = testing::TempDir() + "/render_pan_cli";
+  expect_error(run("hybrid_vo_render_pan", "--kitti-dir " + out), "--photo");
+  expect_error(run("hybrid_vo_render_pan", "--photo /no/such.jpg --K 800,800,799.5,449.5 "
+                                           "--kitti-dir " + out),
+               "/no/such.jpg");
+  expect_error(run("hybrid_vo_render_pan", "--photo " + kImage + " --kitti-dir " + out),
+               "no intrinsics for " + kImage);
+  const std::string camera = testing::TempDir() + "/render_pan_cli.camera";
+  std::ofstream(camera) << "2759.48 0 1520.69\n0 2764.16 1006.81\n";
+  expect_error(run("hybrid_vo_render_pan",
+                   "--photo " + kImage + " --camera " + camera + " --kitti-dir " + out),
+               camera + ":2: expected 26 numbers");
+  expect_error(run("hybrid_vo_render_pan", "--photo " + kImage +
+                                               " --camera /no/such.camera --kitti-dir " + out),
+               "/no/such.camera");
+  // f 2000 in the photograph (22 degrees to its sides) and 1000 in the view (18 to its own):
+  // an 8-degree yaw leaves the photograph.
+  expect_error(run("hybrid_vo_render_pan", "--photo " + kImage +
+                                               " --K 2000,2000,799.5,449.5 --kitti-dir " + out),
+               "view leaves the 1600x900 photograph");
+}
+
+TEST(RenderPanCli, WritesTheKeptFrames) {
+  const std::string out = testing::TempDir() + "/render_pan_cli_ok";
+  std::system(("rm -rf " + out).c_str());
+  const Outcome o = run("hybrid_vo_render_pan",
+                        "--photo " + kImage + " --K 1200,1200,799.5,449.5 --width 320 --height 240 "
+                        "--focal 500 --frames 20 --drop-every 4 --kitti-name pan --kitti-dir " +
+                            out);
+  ASSERT_EQ(o.exit_code, 0) << o.output;
+  EXPECT_NE(o.output.find("rendered 15 of 20 frames (5 dropped)"), std::string::npos) << o.output;
+  std::ifstream times(out + "/sequences/pan/times.txt"), poses(out + "/poses/pan.txt");
+  std::vector<double> stamps;
+  for (double t; times >> t;) stamps.push_back(t);
+  ASSERT_EQ(stamps.size(), 15u);
+  EXPECT_NEAR(stamps[3], 4.0 / 30.0, 1e-8);  // frame 3 left out
+  int lines = 0;
+  for (std::string line; std::getline(poses, line);) ++lines;
+  EXPECT_EQ(lines, 15);
+  EXPECT_TRUE(std::ifstream(out + "/sequences/pan/image_0/000014.png").good());
+}
+
 TEST(EvalTrajectoryCli, MissingBag) {
   expect_error(run("hybrid_vo_eval_trajectory", "--bag /no/run.bag --gt /no/gt.bag"),
                "/no/run.bag");

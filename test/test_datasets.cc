@@ -791,6 +791,34 @@ TEST(Strecha, ReadsPerImageCamerasAndRecoversTheRelativePose) {
   EXPECT_TRUE(contains(error, "unknown data set format 'eth3d'"));
 }
 
+// One image's camera, found from the image's path (hybrid_vo_render_pan's default).
+TEST(Strecha, ReadsOneCameraFoundBesideItsImage) {
+  TempDir dir;
+  StrechaFixture fixture(dir.path() / "fountain-P3");
+  fixture.write();
+  const std::string image = (fixture.dir / "images" / fixture.image_name(1)).string();
+  const std::string found = strecha_camera_of_image(image);
+  EXPECT_EQ(fs::path(found), fs::path(fixture.camera_path(1)).lexically_normal());
+  Frame frame;
+  std::string error;
+  ASSERT_TRUE(read_strecha_camera(found, &frame, &error)) << error;
+  EXPECT_DOUBLE_EQ(frame.camera.pinhole.fx, 2760.48);
+  EXPECT_EQ(frame.camera.pinhole.width, 3072);
+  EXPECT_LT((frame.R_wc - fixture.chain.R_wc[1]).norm(), 1e-12);
+  EXPECT_LT((frame.c_w - fixture.chain.c_w[1]).norm(), 1e-12);
+  // Without the layout: FILE.camera beside the image, or nothing.
+  write_file(dir.path() / "loose.jpg", "");
+  EXPECT_EQ(strecha_camera_of_image((dir.path() / "loose.jpg").string()), "");
+  write_file(dir.path() / "loose.jpg.camera", join_lines(fixture.cameras[0]));
+  EXPECT_EQ(fs::path(strecha_camera_of_image((dir.path() / "loose.jpg").string())),
+            dir.path() / "loose.jpg.camera");
+  EXPECT_FALSE(read_strecha_camera((dir.path() / "none.camera").string(), &frame, &error));
+  EXPECT_TRUE(contains(error, "none.camera"));
+  write_file(dir.path() / "short.camera", "1 2 3\n");
+  EXPECT_FALSE(read_strecha_camera((dir.path() / "short.camera").string(), &frame, &error));
+  EXPECT_TRUE(contains(error, "expected 26 numbers"));
+}
+
 TEST(Strecha, ReportsMissingFilesAndMalformedLines) {
   TempDir dir;
   StrechaFixture* f = nullptr;

@@ -1,7 +1,8 @@
 // The synthetic sequence renderer: determinism, geometry (depth, painted corners, motion and
 // stereo consistent with the ground truth), image content that real detectors find (corners,
-// long segments through the Manhattan VPs), the walk, option checking, and the low-texture
-// variant (plain surfaces: only edges, noise elsewhere, few trackable corners).
+// long segments through the Manhattan VPs), the walk and the other motions (rest, turning in
+// place, starting from rest), option checking, and the low-texture variant (plain surfaces: only
+// edges, noise elsewhere, few trackable corners).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -460,6 +461,196 @@ TEST_F(RenderTest, WalkTurnsAndStaysInside) {
 }
 
 // ------------------------------------------------------------------------------------------------
+// The other motions (--motion rest|turn|ramp) and the walk they must leave as it was.
+
+Scene motion_scene(SceneType type) {
+  SceneOptions o;
+  o.type = type;
+  o.texels_per_metre = 64;  // the route and the free space do not depend on the textures
+  return build_scene(o);
+}
+
+Trajectory motion_path(const Scene& scene, Motion motion, int frames, double rate = 10.0) {
+  PathOptions o;
+  o.motion = motion;
+  o.num_frames = frames;
+  o.rate_hz = rate;
+  return make_trajectory(scene, o);
+}
+
+Eigen::Vector3d level(Eigen::Vector3d v) {
+  v.z() = 0.0;
+  return v;
+}
+
+TEST(CameraMotion, WalkIsUnchanged) {
+  const Scene scene = motion_scene(SceneType::kCorridor);
+  const Trajectory walk = motion_path(scene, Motion::kWalk, 150);
+  const Trajectory by_default = make_trajectory(scene, PathOptions{});
+  ASSERT_EQ(walk.poses.size(), by_default.poses.size());
+  for (size_t i = 0; i < walk.poses.size(); ++i) {
+    EXPECT_EQ(walk.poses[i].R_world_from_camera, by_default.poses[i].R_world_from_camera);
+    EXPECT_EQ(walk.poses[i].centre, by_default.poses[i].centre);
+  }
+  // Frame 37 (in the first turn) as the renderer wrote it before the motions existed.
+  Eigen::Matrix<double, 3, 4, Eigen::RowMajor> before;
+  before << 9.880643992795e-01, -8.020739539813e-04, 1.540392792562e-01, 1.670149008850e+01,
+      -1.537588677823e-01, -6.566940251016e-02, 9.859238003782e-01, 2.779203673205e+00,
+      9.324883630960e-03, -9.978411127285e-01, -6.500892472529e-02, 1.440348836809e+00;
+  EXPECT_LT((walk.poses[37].R_world_from_camera - before.leftCols<3>()).norm(), 1e-11);
+  EXPECT_LT((walk.poses[37].centre - before.col(3)).norm(), 1e-10);
+}
+
+TEST(CameraMotion, RestStandsStillAtTheRoutesStart) {
+  for (SceneType type : {SceneType::kCorridor, SceneType::kRoom}) {
+    const Scene scene = motion_scene(type);
+    const Trajectory rest = motion_path(scene, Motion::kRest, 40);
+    PathOptions still;
+    still.sway = false;
+    const CameraPose start = make_trajectory(scene, still).poses[0];
+    ASSERT_EQ(rest.poses.size(), 40u);
+    for (const CameraPose& pose : rest.poses) {
+      EXPECT_EQ(pose.R_world_from_camera, start.R_world_from_camera);
+      EXPECT_EQ(pose.centre, start.centre);
+    }
+    EXPECT_EQ(rest.length, 0.0);
+    EXPECT_EQ(rest.total_turn_deg, 0.0);
+    EXPECT_NEAR(rest.times.back(), 3.9, 1e-12);
+  }
+}
+
+TEST(CameraMotion, TurnIsAboutAVerticalAxisBehindTheCamera) {
+  constexpr double kRate = 30.0;
+  for (SceneType type : {SceneType::kCorridor, SceneType::kRoom})
+    for (double lever_arm : {0.2, 0.0, 0.35}) {
+      const Scene scene = motion_scene(type);
+      PathOptions o;
+      o.motion = Motion::kTurn;
+      o.lever_arm = lever_arm;
+      o.num_frames = 451;  // 15 s: 435 degrees, once round and more
+      o.rate_hz = kRate;
+      const Trajectory turn = make_trajectory(scene, o);
+      const CameraPose& first = turn.poses[0];
+      const Eigen::Vector3d pivot =
+          first.centre - lever_arm * level(first.R_world_from_camera.col(2)).normalized();
+      double yaw = 0.0, max_rate = 0.0;
+      for (size_t i = 0; i < turn.poses.size(); ++i) {
+        const CameraPose& pose = turn.poses[i];
+        const Eigen::Vector3d arm = pose.centre - pivot;
+        EXPECT_NEAR(arm.z(), 0.0, 1e-12);
+        EXPECT_NEAR(arm.norm(), lever_arm, 1e-12) << "frame " << i;
+        // The camera looks away from the axis: the arm is its level forward direction.
+        if (lever_arm > 0.0) {
+          EXPECT_LT((arm.normalized() - level(pose.R_world_from_camera.col(2)).normalized()).norm(),
+                    1e-9);
+        }
+        if (i == 0) continue;
+        const Eigen::AngleAxisd step(pose.R_world_from_camera *
+                                     turn.poses[i - 1].R_world_from_camera.transpose());
+        if (step.angle() > 1e-9) {
+          EXPECT_NEAR(step.axis().z(), 1.0, 1e-9) << "frame " << i;
+        }
+        const double rate_deg = step.angle() * kRate * 180.0 / kPi;
+        EXPECT_GE(rate_deg, max_rate - 1e-6) << "frame " << i;  // rises, then holds
+        max_rate = std::max(max_rate, rate_deg);
+        if (i <= 30) {
+          EXPECT_LT(rate_deg, 30.0 + 1e-6);
+        } else if (i > 31) {
+          EXPECT_NEAR(rate_deg, 30.0, 1e-6) << "frame " << i;
+        }
+        yaw += step.angle();
+      }
+      EXPECT_LT(turn.poses[1].R_world_from_camera.col(2).dot(first.R_world_from_camera.col(2)),
+                1.0);
+      EXPECT_NEAR(yaw * 180.0 / kPi, 30.0 * (15.0 - 0.5), 1e-6);
+      EXPECT_NEAR(turn.total_turn_deg, 435.0, 1e-6);
+      EXPECT_NEAR(turn.length, 2.0 * kPi * lever_arm * 435.0 / 360.0, 1e-3);
+    }
+}
+
+TEST(CameraMotion, TurnStopsAndTurnsRight) {
+  const Scene scene = motion_scene(SceneType::kCorridor);
+  PathOptions o;
+  o.motion = Motion::kTurn;
+  o.num_frames = 61;
+  o.turn_stop = true;
+  o.turn_rate_deg = -45.0;
+  const Trajectory turn = make_trajectory(scene, o);
+  auto step = [&](int i) {
+    return Eigen::AngleAxisd(turn.poses[i].R_world_from_camera *
+                             turn.poses[i - 1].R_world_from_camera.transpose());
+  };
+  EXPECT_NEAR(step(30).axis().z(), -1.0, 1e-9);  // negative: to the right
+  EXPECT_NEAR(step(30).angle() * 10.0 * 180.0 / kPi, 45.0, 1e-6);
+  EXPECT_LT(step(60).angle() * 10.0 * 180.0 / kPi, 45.0 * 0.03);  // ramped down
+  EXPECT_NEAR(turn.total_turn_deg, 45.0 * (6.0 - 1.0), 1e-6);
+  o.num_frames = 15;  // 1.4 s: no room for the two ramps
+  EXPECT_THROW(make_trajectory(scene, o), std::invalid_argument);
+}
+
+TEST(CameraMotion, RampRestsThenReachesTheWalk) {
+  const Scene scene = motion_scene(SceneType::kCorridor);
+  PathOptions o;
+  o.motion = Motion::kRamp;
+  o.num_frames = 80;
+  const Trajectory ramp = make_trajectory(scene, o);
+  for (int i = 1; i <= 10; ++i) {  // 1 s at rest
+    EXPECT_EQ(ramp.poses[i].centre, ramp.poses[0].centre);
+    EXPECT_EQ(ramp.poses[i].R_world_from_camera, ramp.poses[0].R_world_from_camera);
+  }
+  EXPECT_GT((ramp.poses[11].centre - ramp.poses[10].centre).norm(), 0.0);
+  // After the ramp, the walk delayed by the rest and half the ramp, sway and all.
+  PathOptions walk;
+  walk.start = -1.5 * (1.0 + 1.0);
+  walk.num_frames = 80;
+  const Trajectory delayed = make_trajectory(scene, walk);
+  for (int i = 30; i < 80; ++i) {
+    EXPECT_LT((ramp.poses[i].centre - delayed.poses[i].centre).norm(), 1e-9) << "frame " << i;
+    EXPECT_LT((ramp.poses[i].R_world_from_camera - delayed.poses[i].R_world_from_camera).norm(),
+              1e-9);
+  }
+  // Without the sway the speed rises smoothly from 0 to 1.5 m/s.
+  o.sway = false;
+  const Trajectory smooth = make_trajectory(scene, o);
+  double previous = 0.0;
+  for (int i = 11; i < 40; ++i) {
+    const double speed = (smooth.poses[i].centre - smooth.poses[i - 1].centre).norm() * 10.0;
+    EXPECT_GE(speed, previous - 1e-9) << "frame " << i;
+    EXPECT_LT(speed - previous, 0.2) << "frame " << i;  // no jump
+    previous = speed;
+  }
+  EXPECT_NEAR(previous, 1.5, 1e-3);
+}
+
+TEST(CameraMotion, EveryMotionIsRenderedInStereo) {
+  for (const char* motion : {"walk", "rest", "turn", "ramp"}) {
+    std::vector<std::string> args = {"--out",  "x.bag", "--stereo", "--motion", motion,
+                                     "--frames", "12", "--width", "64", "--height",
+                                     "48",     "--scene", "room"};
+    if (std::string(motion) == "ramp") args.insert(args.end(), {"--rest-seconds", "0.2"});
+    SequenceOptions options;
+    ASSERT_EQ(parse_sequence_args(args, &options), "");
+    const Sequence seq = make_sequence(options);
+    ASSERT_EQ(seq.trajectory.poses.size(), 12u);
+    for (int frame : {0, 11}) {
+      const CameraPose left = frame_pose(seq, frame), right = frame_pose(seq, frame, true);
+      EXPECT_LT((left.to_camera(right.centre) - Eigen::Vector3d(0.12, 0, 0)).norm(), 1e-12);
+      EXPECT_EQ(right.R_world_from_camera, left.R_world_from_camera);
+    }
+    const RenderedView a = render_frame(seq, 0), b = render_frame(seq, 11);
+    const RenderedView r = render_frame(seq, 11, true);
+    EXPECT_EQ(a.image.size(), cv::Size(64, 48));
+    EXPECT_EQ(r.image.size(), cv::Size(64, 48));
+    const double change = cv::norm(a.image, b.image, cv::NORM_L1) / a.image.total();
+    if (std::string(motion) == "rest") {  // the noise alone: 1 grey level, about 1.1 apart
+      EXPECT_LT(change, 2.0) << motion;
+    } else {
+      EXPECT_GT(change, 2.0) << motion;
+    }
+  }
+}
+
+// ------------------------------------------------------------------------------------------------
 // The low-texture variant (--texture plain): the same corridor and walk with plain surfaces.
 
 class PlainRenderTest : public ::testing::Test {
@@ -755,6 +946,25 @@ TEST(RenderOptions, ArgumentsAreParsedAndBadOnesRejected) {
   EXPECT_EQ(more.compressed_images, "jpeg");
   EXPECT_EQ(more.jpeg_quality, 80);
 
+  SequenceOptions turn;
+  EXPECT_EQ(parse_sequence_args({"--out", "x.bag", "--motion", "turn", "--lever-arm", "0",
+                                 "--turn-rate", "-20", "--turn-stop"},
+                                &turn),
+            "");
+  EXPECT_EQ(turn.motion, Motion::kTurn);
+  EXPECT_EQ(turn.lever_arm, 0.0);
+  EXPECT_EQ(turn.turn_rate, -20.0);
+  EXPECT_TRUE(turn.turn_stop);
+  SequenceOptions ramp;
+  EXPECT_EQ(parse_sequence_args({"--out", "x.bag", "--motion", "ramp", "--rest-seconds", "0.5",
+                                 "--ramp-seconds", "3"},
+                                &ramp),
+            "");
+  EXPECT_EQ(ramp.motion, Motion::kRamp);
+  EXPECT_EQ(ramp.rest_seconds, 0.5);
+  EXPECT_EQ(ramp.ramp_seconds, 3.0);
+  EXPECT_EQ(o.motion, Motion::kWalk);
+
   const std::vector<std::vector<std::string>> bad = {
       {},         // no --out
       {"--out"},  // missing value
@@ -783,6 +993,18 @@ TEST(RenderOptions, ArgumentsAreParsedAndBadOnesRejected) {
       {"--out", "x.bag", "--compressed", "gif"},
       {"--out", "x.bag", "--jpeg-quality", "101"},
       {"--kitti-dir", "/tmp/k", "--fisheye-fov", "150"},  // calib.txt is pinhole
+      {"--out", "x.bag", "--motion", "fly"},
+      {"--out", "x.bag", "--motion", "turn", "--lever-arm", "-0.1"},
+      {"--out", "x.bag", "--motion", "turn", "--lever-arm", "nan"},
+      {"--out", "x.bag", "--motion", "turn", "--turn-rate", "inf"},
+      {"--out", "x.bag", "--motion", "turn", "--turn-rate", "nan"},
+      {"--out", "x.bag", "--motion", "turn", "--turn-rate", "400"},
+      {"--out", "x.bag", "--motion", "ramp", "--rest-seconds", "-1"},
+      {"--out", "x.bag", "--motion", "ramp", "--ramp-seconds", "nan"},
+      {"--out", "x.bag", "--lever-arm", "0.3"},  // an option of the turn, for the walk
+      {"--out", "x.bag", "--motion", "turn", "--rest-seconds", "2"},
+      {"--out", "x.bag", "--motion", "ramp", "--turn-stop"},
+      {"--out", "x.bag", "--motion", "rest", "--laps", "1"},
   };
   for (const auto& args : bad) {
     SequenceOptions options;
@@ -826,6 +1048,19 @@ TEST(RenderOptions, InvalidSceneCameraAndPathAreRejected) {
   EXPECT_THROW(path_with([](PathOptions& p) { p.speed = 10.0; }), std::invalid_argument);
   EXPECT_THROW(path_with([](PathOptions& p) { p.camera_height = 2.6; }), std::invalid_argument);
   EXPECT_NO_THROW(path_with([](PathOptions&) {}));
+  EXPECT_THROW(path_with([](PathOptions& p) { p.lever_arm = -0.1; }), std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.lever_arm = kNaN; }), std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.turn_rate_deg = kNaN; }), std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.turn_rate_deg = HUGE_VAL; }),
+               std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.rest_seconds = -1.0; }), std::invalid_argument);
+  EXPECT_THROW(path_with([](PathOptions& p) { p.ramp_seconds = kNaN; }), std::invalid_argument);
+  // A circle through the corridor's walls.
+  EXPECT_THROW(path_with([](PathOptions& p) {
+                 p.motion = Motion::kTurn;
+                 p.lever_arm = 1.9;
+               }),
+               std::invalid_argument);
 
   const CameraPose pose = make_trajectory(scene, PathOptions{}).poses[0];
   PinholeCamera cam = default_camera(64, 48);

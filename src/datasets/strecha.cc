@@ -23,8 +23,10 @@ bool ends_with(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-// One .camera file: 26 numbers, line breaks free, so each number keeps its own line for errors.
-bool read_camera_file(const std::string& path, Frame* frame, std::string* error) {
+}  // namespace
+
+// 26 numbers, line breaks free, so each number keeps its own line for errors.
+bool read_strecha_camera(const std::string& path, Frame* frame, std::string* error) {
   std::vector<std::string> lines;
   if (!read_lines(path, &lines, error)) return false;
   std::vector<std::pair<std::string, int>> tokens;
@@ -68,7 +70,16 @@ bool read_camera_file(const std::string& path, Frame* frame, std::string* error)
   return true;
 }
 
-}  // namespace
+
+std::string strecha_camera_of_image(const std::string& image_path) {
+  const fs::path image(image_path);
+  const std::string file = image.filename().string() + kCameraSuffix;
+  std::error_code ec;
+  for (const fs::path& candidate :
+       {image.parent_path() / ".." / "gt_dense_cameras" / file, image.parent_path() / file})
+    if (fs::is_regular_file(candidate, ec)) return candidate.lexically_normal().string();
+  return "";
+}
 
 bool read_strecha(const std::string& path, Sequence* sequence, std::string* error) {
   fs::path dir = fs::path(path).lexically_normal();
@@ -96,7 +107,7 @@ bool read_strecha(const std::string& path, Sequence* sequence, std::string* erro
   for (size_t k = 0; k < camera_files.size(); ++k) {
     Frame& frame = sequence->frames[k];
     const std::string camera_path = (camera_dir / camera_files[k]).string();
-    if (!read_camera_file(camera_path, &frame, error)) return false;
+    if (!read_strecha_camera(camera_path, &frame, error)) return false;
     const std::string image =
         camera_files[k].substr(0, camera_files[k].size() - (sizeof(kCameraSuffix) - 1));
     frame.image_path = (image_dir / image).string();

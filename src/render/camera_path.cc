@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "painter.h"
+#include "route.h"
 
 namespace hybrid_vo {
 namespace render {
@@ -15,86 +16,22 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 
-// One piece of the rounded route: a straight line, or a quarter circle around `centre`.
-struct Piece {
-  bool arc = false;
-  Eigen::Vector2d start = Eigen::Vector2d::Zero(), dir = Eigen::Vector2d::Zero();  // line
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();                                // arc
-  Eigen::Vector2d d_in = Eigen::Vector2d::Zero(), d_out = Eigen::Vector2d::Zero();
-  double radius = 0.0, length = 0.0;
-};
-
-std::vector<Piece> route_pieces(const Scene& scene) {
-  const std::vector<Eigen::Vector2d>& p = scene.route;
-  const int n = static_cast<int>(p.size());
-  if (n < 3) throw std::invalid_argument("render path: the scene has no route");
-  const double r = scene.route_corner_radius;
-  std::vector<double> trim(n, 0.0);
-  for (int i = 0; i < n; ++i) {
-    const Eigen::Vector2d d_in = (p[i] - p[(i + n - 1) % n]).normalized();
-    const Eigen::Vector2d d_out = (p[(i + 1) % n] - p[i]).normalized();
-    const double turn = d_in.x() * d_out.y() - d_in.y() * d_out.x();
-    if (std::abs(turn) > 1e-9) {
-      if (std::abs(d_in.dot(d_out)) > 1e-9)
-        throw std::invalid_argument("render path: route corners must be right angles");
-      trim[i] = r;
-    }
-  }
-  std::vector<Piece> pieces;
-  for (int i = 0; i < n; ++i) {
-    const int j = (i + 1) % n;
-    const Eigen::Vector2d d = (p[j] - p[i]).normalized();
-    Piece line;
-    line.start = p[i] + trim[i] * d;
-    line.dir = d;
-    line.length = (p[j] - p[i]).norm() - trim[i] - trim[j];
-    if (line.length < 0.0) throw std::invalid_argument("render path: route edge too short");
-    pieces.push_back(line);
-    if (trim[j] > 0.0) {
-      Piece arc;
-      arc.arc = true;
-      arc.d_in = d;
-      arc.d_out = (p[(j + 1) % n] - p[j]).normalized();
-      arc.radius = r;
-      arc.centre = p[j] - r * arc.d_in + r * arc.d_out;
-      arc.length = 0.5 * kPi * r;
-      pieces.push_back(arc);
-    }
-  }
-  return pieces;
-}
-
-// Position and unit tangent at arc length s (wrapped onto the loop).
-void evaluate(const std::vector<Piece>& pieces, double total, double s, Eigen::Vector2d* pos,
-              Eigen::Vector2d* tangent) {
-  s = std::fmod(s, total);
-  if (s < 0.0) s += total;
-  for (const Piece& piece : pieces) {
-    if (s > piece.length && &piece != &pieces.back()) {
-      s -= piece.length;
-      continue;
-    }
-    s = std::min(s, piece.length);
-    if (!piece.arc) {
-      *pos = piece.start + s * piece.dir;
-      *tangent = piece.dir;
-    } else {
-      const double t = s / piece.radius;
-      *pos = piece.centre + piece.radius * (-piece.d_out * std::cos(t) + piece.d_in * std::sin(t));
-      *tangent = piece.d_out * std::sin(t) + piece.d_in * std::cos(t);
-    }
-    return;
-  }
-}
-
-double total_length(const std::vector<Piece>& pieces) {
-  double total = 0.0;
-  for (const Piece& piece : pieces) total += piece.length;
-  return total;
-}
-
 void check(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument("render path: " + what);
+}
+
+// 0 before t = 0, 1 after `duration`, a raised cosine between: no jump in the speed's slope.
+double smooth_ramp(double t, double duration) {
+  if (t <= 0.0) return 0.0;
+  if (t >= duration) return 1.0;
+  return 0.5 * (1.0 - std::cos(kPi * t / duration));
+}
+
+// Its integral from 0 to t: the distance (or angle) at unit final speed.
+double smooth_ramp_integral(double t, double duration) {
+  if (t <= 0.0) return 0.0;
+  if (t >= duration) return t - 0.5 * duration;
+  return 0.5 * t - duration / (2.0 * kPi) * std::sin(kPi * t / duration);
 }
 
 }  // namespace
@@ -112,7 +49,30 @@ CameraPose stereo_right(const CameraPose& left, double baseline) {
   return right;
 }
 
-double route_length(const Scene& scene) { return total_length(route_pieces(scene)); }
+double route_length(const Scene& scene) { return route_length(route_pieces(scene)); }
+
+bool parse_motion(const std::string& name, Motion* motion) {
+  for (Motion m : {Motion::kWalk, Motion::kRest, Motion::kTurn, Motion::kRamp})
+    if (name == to_string(m)) {
+      *motion = m;
+      return true;
+    }
+  return false;
+}
+
+const char* to_string(Motion motion) {
+  switch (motion) {
+    case Motion::kWalk:
+      return "walk";
+    case Motion::kRest:
+      return "rest";
+    case Motion::kTurn:
+      return "turn";
+    case Motion::kRamp:
+      return "ramp";
+  }
+  return "?";
+}
 
 Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
   check(o.num_frames >= 1 && o.num_frames <= 1000000, "num_frames must be in [1, 1e6]");
@@ -125,36 +85,47 @@ Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
         "camera height must be at least 0.4 m from floor and ceiling");
   check(std::isfinite(o.pitch_down_deg) && std::abs(o.pitch_down_deg) <= 30.0,
         "pitch must be within +-30 degrees");
+  check(std::isfinite(o.lever_arm) && o.lever_arm >= 0.0 && o.lever_arm <= 2.0,
+        "the lever arm must be in [0, 2] m");
+  check(std::isfinite(o.turn_rate_deg) && std::abs(o.turn_rate_deg) <= 360.0,
+        "the turn rate must be within +-360 deg/s");
+  check(std::isfinite(o.turn_ramp_seconds) && o.turn_ramp_seconds >= 0.0 &&
+            o.turn_ramp_seconds <= 60.0,
+        "the turn's ramp must be in [0, 60] s");
+  check(std::isfinite(o.rest_seconds) && o.rest_seconds >= 0.0 && o.rest_seconds <= 3600.0,
+        "the rest must be in [0, 3600] s");
+  check(std::isfinite(o.ramp_seconds) && o.ramp_seconds >= 0.0 && o.ramp_seconds <= 600.0,
+        "the ramp must be in [0, 600] s");
+  const double duration = (o.num_frames - 1) / o.rate_hz;
+  check(o.motion != Motion::kTurn || !o.turn_stop || duration >= 2.0 * o.turn_ramp_seconds,
+        "a turn that stops needs frames for two ramps (" +
+            std::to_string(2.0 * o.turn_ramp_seconds) + " s)");
 
-  const std::vector<Piece> pieces = route_pieces(scene);
-  const double total = total_length(pieces);
+  const std::vector<RoutePiece> pieces = route_pieces(scene);
+  const double total = route_length(pieces);
   Rng rng(hash_mix(o.seed, 0x9A7B));
   double phase[6];
   for (double& p : phase) p = rng.uniform(0.0, 2.0 * kPi);
-  const double sway = o.sway ? 1.0 : 0.0;
   const double stride = 1.5;  // metres per gait cycle (two steps)
 
-  Trajectory traj;
-  double previous_heading = 0.0;
-  for (int i = 0; i < o.num_frames; ++i) {
-    const double time = i / o.rate_hz;
-    const double s = o.start + o.speed * time;
+  // The walk's pose at arc length s, its sway scaled by `sway` (0: none), and its heading.
+  auto walk_pose = [&](double s, double sway, double* heading) {
     Eigen::Vector2d pos = Eigen::Vector2d::Zero(), tangent = Eigen::Vector2d::UnitX();
-    evaluate(pieces, total, s, &pos, &tangent);
+    point_on_route(pieces, total, s, &pos, &tangent);
     // Heading: the tangent averaged with triangular weights over +-2 m, so that the yaw rate
     // ramps up and down smoothly and a 90-degree turn takes about 4 m (peak 50 deg/s at 1.5 m/s).
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (int k = -20; k <= 20; ++k) {
       Eigen::Vector2d p2 = Eigen::Vector2d::Zero(), t2 = Eigen::Vector2d::Zero();
-      evaluate(pieces, total, s + 0.1 * k, &p2, &t2);
+      point_on_route(pieces, total, s + 0.1 * k, &p2, &t2);
       mean += (21 - std::abs(k)) * t2;
     }
-    const double heading = std::atan2(mean.y(), mean.x());
+    *heading = std::atan2(mean.y(), mean.x());
     const Eigen::Vector2d left(-tangent.y(), tangent.x());
     const double cycle = 2.0 * kPi * s / stride;
     pos += sway * 0.025 * std::sin(cycle + phase[0]) * left;
     const double z = o.camera_height + sway * 0.015 * std::sin(2.0 * cycle + phase[1]);
-    const double yaw = heading + scene.route_look_left_deg * kDeg +
+    const double yaw = *heading + scene.route_look_left_deg * kDeg +
                        sway * 1.0 * kDeg * std::sin(2.0 * kPi * s / 2.9 + phase[2]);
     const double pitch =
         o.pitch_down_deg * kDeg + sway * 1.2 * kDeg * std::sin(2.0 * kPi * s / 3.7 + phase[3]);
@@ -167,6 +138,50 @@ Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
     CameraPose pose;
     pose.R_world_from_camera = R_world_from_base * base_from_optical();
     pose.centre = Eigen::Vector3d(pos.x(), pos.y(), z);
+    return pose;
+  };
+
+  const double full_sway = o.sway ? 1.0 : 0.0;
+  double start_heading = 0.0;
+  const CameraPose start = walk_pose(o.start, 0.0, &start_heading);
+  // The turn's pivot: lever_arm behind the centre, level with it.
+  Eigen::Vector3d forward = start.R_world_from_camera.col(2);
+  forward.z() = 0.0;
+  const Eigen::Vector3d pivot = start.centre - o.lever_arm * forward.normalized();
+  const double turn_rate = o.turn_rate_deg * kDeg;
+
+  Trajectory traj;
+  double previous_heading = 0.0;
+  for (int i = 0; i < o.num_frames; ++i) {
+    const double time = i / o.rate_hz;
+    double heading = start_heading;
+    CameraPose pose = start;
+    switch (o.motion) {
+      case Motion::kWalk:
+        pose = walk_pose(o.start + o.speed * time, full_sway, &heading);
+        break;
+      case Motion::kRest:
+        break;
+      case Motion::kTurn: {
+        double angle = turn_rate * smooth_ramp_integral(time, o.turn_ramp_seconds);
+        if (o.turn_stop)
+          angle -= turn_rate * smooth_ramp_integral(time - (duration - o.turn_ramp_seconds),
+                                                    o.turn_ramp_seconds);
+        const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).matrix();
+        pose.R_world_from_camera = R * start.R_world_from_camera;
+        pose.centre = pivot + R * (start.centre - pivot);
+        heading = start_heading + angle;
+        check(scene.is_free(pose.centre, 0.3),
+              "the turn's circle leaves the free space (shorten the lever arm)");
+        break;
+      }
+      case Motion::kRamp: {
+        const double moving = time - o.rest_seconds;
+        pose = walk_pose(o.start + o.speed * smooth_ramp_integral(moving, o.ramp_seconds),
+                         full_sway * smooth_ramp(moving, o.ramp_seconds), &heading);
+        break;
+      }
+    }
     if (i > 0) {
       traj.length += (pose.centre - traj.poses.back().centre).norm();
       traj.total_turn_deg += std::abs(std::remainder(heading - previous_heading, 2.0 * kPi)) / kDeg;

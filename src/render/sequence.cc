@@ -2,53 +2,22 @@
 
 #include <unistd.h>
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
+#include "number_arguments.h"
 #include "painter.h"
 
 namespace hybrid_vo {
 namespace render {
-namespace {
-
-bool parse_int(const std::string& s, int lo, int hi, int* out) {
-  char* end = nullptr;
-  errno = 0;
-  const long v = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || *end || errno || v < lo || v > hi) return false;
-  *out = static_cast<int>(v);
-  return true;
-}
-
-bool parse_double(const std::string& s, double lo, double hi, bool open_lo, double* out) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || *end || !std::isfinite(v) || v > hi || v < lo || (open_lo && v == lo))
-    return false;
-  *out = v;
-  return true;
-}
-
-bool parse_u64(const std::string& s, uint64_t* out) {
-  if (s.empty() || s[0] == '-') return false;
-  char* end = nullptr;
-  errno = 0;
-  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-  if (*end || errno) return false;
-  *out = v;
-  return true;
-}
-
-}  // namespace
 
 std::string sequence_usage(const std::string& program) {
   std::ostringstream s;
   s << "Usage: " << program << " --out OUT.bag | --kitti-dir DIR [options]\n"
-    << "Renders a synthetic Manhattan sequence (textured corridor or room, a walk with turns)\n"
+    << "Renders a synthetic Manhattan sequence (textured corridor or room, a walk with turns,\n"
+    << "or standing, turning in place, starting from rest: --motion)\n"
     << "into a bag: /camera/left/{image_raw,camera_info} (and /camera/right/... with --stereo),\n"
     << "/ground_truth/pose, /tf (world -> gt_camera_left_optical) and /tf_static; and/or into\n"
     << "the KITTI odometry layout.\n"
@@ -63,6 +32,18 @@ std::string sequence_usage(const std::string& program) {
     << "                     (low texture: only the edges of walls, boxes, doors, floor joints)\n"
     << "  --baseline M       stereo baseline in metres (default 0.12)\n"
     << "  --speed M_PER_S    walking speed (default 1.5)\n"
+    << "  --motion walk|rest|turn|ramp  how the camera moves (default walk): walk along the\n"
+    << "                     route; rest: stand still at its start (only the noise changes);\n"
+    << "                     turn: turn in place there like a wheeled robot; ramp: rest, then\n"
+    << "                     start walking\n"
+    << "  --lever-arm M      turn: the vertical axis this far behind the camera (default 0.2;\n"
+    << "                     0: about the camera centre)\n"
+    << "  --turn-rate DEG_S  turn: the yaw rate after a smooth 1 s ramp (default 30; negative:\n"
+    << "                     to the right)\n"
+    << "  --turn-stop        turn: ramp down to rest over the last second\n"
+    << "  --rest-seconds S   ramp: still for S seconds first (default 1)\n"
+    << "  --ramp-seconds S   ramp: then accelerating smoothly to --speed over S seconds\n"
+    << "                     (default 2); the walker's sway grows with the speed\n"
     << "  --focal PX         focal length (default 0.72 * width)\n"
     << "  --fisheye-fov DEG  an equidistant (fisheye) lens of this horizontal field of view\n"
     << "                     instead of the pinhole (camera_info distortion_model equidistant)\n"
@@ -79,6 +60,7 @@ std::string sequence_usage(const std::string& program) {
 }
 
 std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOptions* o) {
+  std::vector<std::string> motion_options;  // given, to check against the motion at the end
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg == "--help" || arg == "-h") {
@@ -89,12 +71,19 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       o->stereo = true;
       continue;
     }
+    if (arg == "--turn-stop") {
+      o->turn_stop = true;
+      motion_options.push_back(arg);
+      continue;
+    }
     static const char* kValued[] = {"--out",           "--png-dir",    "--frames", "--width",
                                     "--height",        "--rate",       "--seed",   "--scene",
                                     "--baseline",      "--speed",      "--focal",  "--noise",
                                     "--supersampling", "--compression", "--laps",
                                     "--texture",       "--kitti-dir",   "--kitti-name",
-                                    "--compressed",    "--jpeg-quality", "--fisheye-fov"};
+                                    "--compressed",    "--jpeg-quality", "--fisheye-fov",
+                                    "--motion",        "--lever-arm",    "--turn-rate",
+                                    "--rest-seconds",  "--ramp-seconds"};
     bool known = false;
     for (const char* name : kValued) known = known || arg == name;
     if (!known) return "unknown argument '" + arg + "'";
@@ -149,7 +138,20 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       ok = parse_double(v, 0.0, 200.0, true, &o->fisheye_fov);
     } else if (arg == "--jpeg-quality") {
       ok = parse_int(v, 1, 100, &o->jpeg_quality);
+    } else if (arg == "--motion") {
+      ok = parse_motion(v, &o->motion);
+    } else if (arg == "--lever-arm") {
+      ok = parse_double(v, 0.0, 2.0, false, &o->lever_arm);
+    } else if (arg == "--turn-rate") {
+      ok = parse_double(v, -360.0, 360.0, false, &o->turn_rate);
+    } else if (arg == "--rest-seconds") {
+      ok = parse_double(v, 0.0, 3600.0, false, &o->rest_seconds);
+    } else if (arg == "--ramp-seconds") {
+      ok = parse_double(v, 0.0, 600.0, false, &o->ramp_seconds);
     }
+    if (arg == "--lever-arm" || arg == "--turn-rate" || arg == "--rest-seconds" ||
+        arg == "--ramp-seconds")
+      motion_options.push_back(arg);
     if (!ok) return "bad value '" + v + "' for " + arg;
   }
   if (o->out_bag.empty() && o->kitti_dir.empty())
@@ -158,6 +160,15 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
     return "--focal and --fisheye-fov exclude each other (the field of view sets the focal)";
   if (!o->kitti_dir.empty() && o->fisheye_fov > 0.0)
     return "--kitti-dir writes a pinhole calib.txt: not with --fisheye-fov";
+  for (const std::string& option : motion_options) {
+    const Motion needs = option == "--rest-seconds" || option == "--ramp-seconds" ? Motion::kRamp
+                                                                                 : Motion::kTurn;
+    if (o->motion != needs)
+      return option + " is an option of --motion " + to_string(needs) + ", not " +
+             to_string(o->motion);
+  }
+  if (o->laps > 0.0 && o->motion != Motion::kWalk)
+    return std::string("--laps measures a walk: not with --motion ") + to_string(o->motion);
   return "";
 }
 
@@ -199,6 +210,12 @@ Sequence make_sequence(const SequenceOptions& options) {
   path.rate_hz = options.rate;
   path.speed = options.speed;
   path.seed = options.seed;
+  path.motion = options.motion;
+  path.lever_arm = options.lever_arm;
+  path.turn_rate_deg = options.turn_rate;
+  path.turn_stop = options.turn_stop;
+  path.rest_seconds = options.rest_seconds;
+  path.ramp_seconds = options.ramp_seconds;
   seq.trajectory = make_trajectory(seq.scene, path);
   seq.camera = default_camera(options.width, options.height);
   if (options.focal > 0.0) seq.camera.fx = seq.camera.fy = options.focal;

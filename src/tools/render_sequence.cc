@@ -159,19 +159,22 @@ int main(int argc, char** argv) {
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count();
     const int views = seq.options.frames * (options.stereo ? 2 : 1);
+    const std::string motion =
+        options.motion == Motion::kWalk ? "" : std::string(", ") + to_string(options.motion);
     std::string outputs = options.out_bag;
     if (to_kitti)
       outputs += (to_bag ? " and " : "") + kitti.sequence_dir() + " (poses " + kitti.poses_path() +
                  ")";
     std::printf(
-        "rendered %d frames (%s, %dx%d, %s%s, %s, %.0f Hz), path %.1f m, turned %.0f deg, "
+        "rendered %d frames (%s, %dx%d, %s%s, %s%s, %.0f Hz), path %.1f m, turned %.0f deg, "
         "%.3f s per view, %.1f s total -> %s\n",
         seq.options.frames, options.stereo ? "stereo" : "mono", options.width, options.height,
         options.fisheye_fov > 0.0
             ? (std::to_string(static_cast<int>(std::lround(options.fisheye_fov))) +
                " deg equidistant, ").c_str()
             : "",
-        to_string(options.scene), to_string(options.texture), options.rate,
+        to_string(options.scene), to_string(options.texture),
+        motion.c_str(), options.rate,
         seq.trajectory.length, seq.trajectory.total_turn_deg, render_seconds / views, total,
         outputs.c_str());
   } catch (const rosbag::BagException& e) {

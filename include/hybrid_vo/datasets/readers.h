@@ -54,6 +54,11 @@ bool read_tum(const std::string& path, Sequence* sequence, std::string* error,
 // R (3x3 row-major, camera-to-world), C (the camera centre in the world), width, height. The
 // projection is x ~ K Rᵀ (X - C); metric. Timestamps are the frame indices.
 bool read_strecha(const std::string& path, Sequence* sequence, std::string* error);
+// One .camera file as a frame without its image: camera (with the size), R_wc and c_w.
+bool read_strecha_camera(const std::string& path, Frame* frame, std::string* error);
+// The .camera file of an image in that layout, <scene>/gt_dense_cameras/<image>.camera for
+// <scene>/images/<image>, or else <image>.camera beside the image; empty when neither exists.
+std::string strecha_camera_of_image(const std::string& image_path);
 
 // A SuperGlue pairs file with ground truth (magicleap/SuperGluePretrainedNetwork,
 // assets/*_pairs_with_gt.txt, as match_pairs.py --eval reads it): 38 whitespace-separated fields

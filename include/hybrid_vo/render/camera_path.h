@@ -1,9 +1,11 @@
 #pragma once
 
-// The camera's walk through a render::Scene: along the scene's route with rounded 90-degree
-// turns, looking where it goes, with a walker's bob and sway. Poses are camera-to-world.
+// The camera's motion through a render::Scene: a walk along the scene's route with rounded
+// 90-degree turns, looking where it goes, with a walker's bob and sway; or, at the route's start,
+// standing still, turning in place, or starting to walk from rest. Poses are camera-to-world.
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -35,7 +37,19 @@ Eigen::Matrix3d base_from_optical();
 // the left camera's x axis.
 CameraPose stereo_right(const CameraPose& left, double baseline);
 
+enum class Motion {
+  kWalk,  // along the route at `speed`
+  kRest,  // standing at the route's start, without sway: only the sensor noise changes
+  kTurn,  // a wheeled robot turning in place at the route's start, about a vertical axis
+  kRamp,  // at rest, then accelerating to `speed`, then the walk
+};
+
+// Parses "walk", "rest", "turn" or "ramp"; false for anything else.
+bool parse_motion(const std::string& name, Motion* motion);
+const char* to_string(Motion motion);
+
 struct PathOptions {
+  Motion motion = Motion::kWalk;
   int num_frames = 150;
   double rate_hz = 10.0;
   double speed = 1.5;  // metres per second along the route
@@ -44,6 +58,18 @@ struct PathOptions {
   double pitch_down_deg = 4.0;
   bool sway = true;   // walking bob, sideways sway, small pitch, roll and yaw wobble
   uint64_t seed = 1;  // phases of the sway
+  // kTurn: the axis is lever_arm metres behind the camera centre (level with it; 0: through the
+  // centre), so the centre moves on a circle of that radius. The yaw rate (positive: to the
+  // left) rises from 0 to turn_rate_deg over turn_ramp_seconds as a raised cosine and holds;
+  // with turn_stop it falls back to 0 over the last turn_ramp_seconds.
+  double lever_arm = 0.2;
+  double turn_rate_deg = 30.0;
+  double turn_ramp_seconds = 1.0;
+  bool turn_stop = false;
+  // kRamp: still for rest_seconds, then the speed rises to `speed` over ramp_seconds as a raised
+  // cosine (no jolt), then the walk goes on. The sway grows with the speed, as a walker's would.
+  double rest_seconds = 1.0;
+  double ramp_seconds = 2.0;
 };
 
 struct Trajectory {
@@ -53,7 +79,8 @@ struct Trajectory {
   double total_turn_deg = 0.0;    // sum of |heading change| between frames (without the wobble)
 };
 
-// Throws std::invalid_argument for invalid options.
+// Throws std::invalid_argument for invalid options, and for a turn whose circle leaves the
+// scene's free space.
 Trajectory make_trajectory(const Scene& scene, const PathOptions& options = {});
 
 // Length of the scene's route (one lap), metres.

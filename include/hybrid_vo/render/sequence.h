@@ -35,6 +35,14 @@ struct SequenceOptions {
   TextureStyle texture = TextureStyle::kTextured;
   double baseline = 0.12;  // metres, stereo only
   double speed = 1.5;      // metres per second
+  // How the camera moves (camera_path.h); the turn's and the ramp's options below apply to
+  // those motions only.
+  Motion motion = Motion::kWalk;
+  double lever_arm = 0.2;     // turn: metres from the camera centre back to the vertical axis
+  double turn_rate = 30.0;    // turn: deg/s (positive: left), reached after a 1 s ramp
+  bool turn_stop = false;     // turn: ramp down to rest over the last second
+  double rest_seconds = 1.0;  // ramp: still at first
+  double ramp_seconds = 2.0;  // ramp: then accelerating to `speed`
   double focal = 0.0;      // pixels; 0: 0.72 * width
   // > 0: an equidistant (fisheye) lens of this horizontal field of view in degrees
   // (fisheye_camera), instead of the pinhole.
