@@ -34,6 +34,103 @@ double smooth_ramp_integral(double t, double duration) {
   return 0.5 * t - duration / (2.0 * kPi) * std::sin(kPi * t / duration);
 }
 
+// The camera's pose at any time since frame 0, for the frames and for the instants within an
+// exposure (motion blur); it copies what it needs, so it outlives the scene and options.
+class CameraPath {
+ public:
+  CameraPath(const Scene& scene, const PathOptions& o)
+      : o_(o),
+        pieces_(route_pieces(scene)),
+        total_(route_length(pieces_)),
+        look_left_(scene.route_look_left_deg * kDeg),
+        duration_((o.num_frames - 1) / o.rate_hz) {
+    Rng rng(hash_mix(o.seed, 0x9A7B));
+    for (double& p : phase_) p = rng.uniform(0.0, 2.0 * kPi);
+    start_ = walk_pose(o.start, 0.0, &start_heading_);
+    // The turn's pivot: lever_arm behind the centre, level with it.
+    Eigen::Vector3d forward = start_.R_world_from_camera.col(2);
+    forward.z() = 0.0;
+    pivot_ = start_.centre - o.lever_arm * forward.normalized();
+  }
+
+  // The pose at `time` and the heading (without the wobble).
+  CameraPose at(double time, double* heading) const {
+    const double full_sway = o_.sway ? 1.0 : 0.0;
+    const double turn_rate = o_.turn_rate_deg * kDeg;
+    *heading = start_heading_;
+    CameraPose pose = start_;
+    switch (o_.motion) {
+      case Motion::kWalk:
+        pose = walk_pose(o_.start + o_.speed * time, full_sway, heading);
+        break;
+      case Motion::kRest:
+        break;
+      case Motion::kTurn: {
+        double angle = turn_rate * smooth_ramp_integral(time, o_.turn_ramp_seconds);
+        if (o_.turn_stop)
+          angle -= turn_rate * smooth_ramp_integral(time - (duration_ - o_.turn_ramp_seconds),
+                                                    o_.turn_ramp_seconds);
+        const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).matrix();
+        pose.R_world_from_camera = R * start_.R_world_from_camera;
+        pose.centre = pivot_ + R * (start_.centre - pivot_);
+        *heading = start_heading_ + angle;
+        break;
+      }
+      case Motion::kRamp: {
+        const double moving = time - o_.rest_seconds;
+        pose = walk_pose(o_.start + o_.speed * smooth_ramp_integral(moving, o_.ramp_seconds),
+                         full_sway * smooth_ramp(moving, o_.ramp_seconds), heading);
+        break;
+      }
+    }
+    return pose;
+  }
+
+ private:
+  static constexpr double kStride = 1.5;  // metres per gait cycle (two steps)
+
+  // The walk's pose at arc length s, its sway scaled by `sway` (0: none), and its heading.
+  CameraPose walk_pose(double s, double sway, double* heading) const {
+    Eigen::Vector2d pos = Eigen::Vector2d::Zero(), tangent = Eigen::Vector2d::UnitX();
+    point_on_route(pieces_, total_, s, &pos, &tangent);
+    // Heading: the tangent averaged with triangular weights over +-2 m, so that the yaw rate
+    // ramps up and down smoothly and a 90-degree turn takes about 4 m (peak 50 deg/s at 1.5 m/s).
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (int k = -20; k <= 20; ++k) {
+      Eigen::Vector2d p2 = Eigen::Vector2d::Zero(), t2 = Eigen::Vector2d::Zero();
+      point_on_route(pieces_, total_, s + 0.1 * k, &p2, &t2);
+      mean += (21 - std::abs(k)) * t2;
+    }
+    *heading = std::atan2(mean.y(), mean.x());
+    const Eigen::Vector2d left(-tangent.y(), tangent.x());
+    const double cycle = 2.0 * kPi * s / kStride;
+    pos += sway * 0.025 * std::sin(cycle + phase_[0]) * left;
+    const double z = o_.camera_height + sway * 0.015 * std::sin(2.0 * cycle + phase_[1]);
+    const double yaw = *heading + look_left_ +
+                       sway * 1.0 * kDeg * std::sin(2.0 * kPi * s / 2.9 + phase_[2]);
+    const double pitch =
+        o_.pitch_down_deg * kDeg + sway * 1.2 * kDeg * std::sin(2.0 * kPi * s / 3.7 + phase_[3]);
+    const double roll = sway * 0.8 * kDeg * std::sin(cycle + phase_[4]);
+    // Body frame x forward, y left, z up; positive pitch tips the nose down.
+    const Eigen::Matrix3d R_world_from_base = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                                  .toRotationMatrix();
+    CameraPose pose;
+    pose.R_world_from_camera = R_world_from_base * base_from_optical();
+    pose.centre = Eigen::Vector3d(pos.x(), pos.y(), z);
+    return pose;
+  }
+
+  PathOptions o_;
+  std::vector<RoutePiece> pieces_;
+  double total_ = 0.0, look_left_ = 0.0, duration_ = 0.0;
+  double phase_[6] = {};
+  CameraPose start_;
+  double start_heading_ = 0.0;
+  Eigen::Vector3d pivot_ = Eigen::Vector3d::Zero();
+};
+
 }  // namespace
 
 Eigen::Matrix3d base_from_optical() {
@@ -101,87 +198,16 @@ Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
         "a turn that stops needs frames for two ramps (" +
             std::to_string(2.0 * o.turn_ramp_seconds) + " s)");
 
-  const std::vector<RoutePiece> pieces = route_pieces(scene);
-  const double total = route_length(pieces);
-  Rng rng(hash_mix(o.seed, 0x9A7B));
-  double phase[6];
-  for (double& p : phase) p = rng.uniform(0.0, 2.0 * kPi);
-  const double stride = 1.5;  // metres per gait cycle (two steps)
-
-  // The walk's pose at arc length s, its sway scaled by `sway` (0: none), and its heading.
-  auto walk_pose = [&](double s, double sway, double* heading) {
-    Eigen::Vector2d pos = Eigen::Vector2d::Zero(), tangent = Eigen::Vector2d::UnitX();
-    point_on_route(pieces, total, s, &pos, &tangent);
-    // Heading: the tangent averaged with triangular weights over +-2 m, so that the yaw rate
-    // ramps up and down smoothly and a 90-degree turn takes about 4 m (peak 50 deg/s at 1.5 m/s).
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    for (int k = -20; k <= 20; ++k) {
-      Eigen::Vector2d p2 = Eigen::Vector2d::Zero(), t2 = Eigen::Vector2d::Zero();
-      point_on_route(pieces, total, s + 0.1 * k, &p2, &t2);
-      mean += (21 - std::abs(k)) * t2;
-    }
-    *heading = std::atan2(mean.y(), mean.x());
-    const Eigen::Vector2d left(-tangent.y(), tangent.x());
-    const double cycle = 2.0 * kPi * s / stride;
-    pos += sway * 0.025 * std::sin(cycle + phase[0]) * left;
-    const double z = o.camera_height + sway * 0.015 * std::sin(2.0 * cycle + phase[1]);
-    const double yaw = *heading + scene.route_look_left_deg * kDeg +
-                       sway * 1.0 * kDeg * std::sin(2.0 * kPi * s / 2.9 + phase[2]);
-    const double pitch =
-        o.pitch_down_deg * kDeg + sway * 1.2 * kDeg * std::sin(2.0 * kPi * s / 3.7 + phase[3]);
-    const double roll = sway * 0.8 * kDeg * std::sin(cycle + phase[4]);
-    // Body frame x forward, y left, z up; positive pitch tips the nose down.
-    const Eigen::Matrix3d R_world_from_base = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                                                  .toRotationMatrix();
-    CameraPose pose;
-    pose.R_world_from_camera = R_world_from_base * base_from_optical();
-    pose.centre = Eigen::Vector3d(pos.x(), pos.y(), z);
-    return pose;
-  };
-
-  const double full_sway = o.sway ? 1.0 : 0.0;
-  double start_heading = 0.0;
-  const CameraPose start = walk_pose(o.start, 0.0, &start_heading);
-  // The turn's pivot: lever_arm behind the centre, level with it.
-  Eigen::Vector3d forward = start.R_world_from_camera.col(2);
-  forward.z() = 0.0;
-  const Eigen::Vector3d pivot = start.centre - o.lever_arm * forward.normalized();
-  const double turn_rate = o.turn_rate_deg * kDeg;
-
+  const CameraPath path(scene, o);
   Trajectory traj;
   double previous_heading = 0.0;
   for (int i = 0; i < o.num_frames; ++i) {
     const double time = i / o.rate_hz;
-    double heading = start_heading;
-    CameraPose pose = start;
-    switch (o.motion) {
-      case Motion::kWalk:
-        pose = walk_pose(o.start + o.speed * time, full_sway, &heading);
-        break;
-      case Motion::kRest:
-        break;
-      case Motion::kTurn: {
-        double angle = turn_rate * smooth_ramp_integral(time, o.turn_ramp_seconds);
-        if (o.turn_stop)
-          angle -= turn_rate * smooth_ramp_integral(time - (duration - o.turn_ramp_seconds),
-                                                    o.turn_ramp_seconds);
-        const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).matrix();
-        pose.R_world_from_camera = R * start.R_world_from_camera;
-        pose.centre = pivot + R * (start.centre - pivot);
-        heading = start_heading + angle;
-        check(scene.is_free(pose.centre, 0.3),
-              "the turn's circle leaves the free space (shorten the lever arm)");
-        break;
-      }
-      case Motion::kRamp: {
-        const double moving = time - o.rest_seconds;
-        pose = walk_pose(o.start + o.speed * smooth_ramp_integral(moving, o.ramp_seconds),
-                         full_sway * smooth_ramp(moving, o.ramp_seconds), &heading);
-        break;
-      }
-    }
+    double heading = 0.0;
+    const CameraPose pose = path.at(time, &heading);
+    if (o.motion == Motion::kTurn)
+      check(scene.is_free(pose.centre, 0.3),
+            "the turn's circle leaves the free space (shorten the lever arm)");
     if (i > 0) {
       traj.length += (pose.centre - traj.poses.back().centre).norm();
       traj.total_turn_deg += std::abs(std::remainder(heading - previous_heading, 2.0 * kPi)) / kDeg;
@@ -190,6 +216,10 @@ Trajectory make_trajectory(const Scene& scene, const PathOptions& o) {
     traj.poses.push_back(pose);
     traj.times.push_back(time);
   }
+  traj.pose_at = [path](double time) {
+    double heading = 0.0;
+    return path.at(time, &heading);
+  };
   return traj;
 }
 

@@ -46,22 +46,44 @@ std::array<Wave, 3> seeded_waves(uint64_t seed) {
   return waves;
 }
 
-// Yaw, pitch and roll (degrees) of every frame at time scale tau (seconds per unit period),
-// each axis scaled so that its largest magnitude over the sequence's time is its amplitude. That
-// peak is taken between the frames too, so that it changes with tau without jumps, and so does
-// the fastest step: the time scale can be found by bisection.
+// Yaw, pitch and roll (degrees) at any time at time scale tau (seconds per unit period), each
+// axis scaled so that its largest magnitude over the sequence's time is its amplitude. That peak
+// is taken between the frames too, so that it changes with tau without jumps, and so does the
+// fastest step: the time scale can be found by bisection.
+class PanAngles {
+ public:
+  PanAngles(const std::array<Wave, 3>& waves, const Eigen::Vector3d& amplitude, int frames,
+            double rate, double tau)
+      : waves_(waves), amplitude_(amplitude), tau_(tau) {
+    constexpr int kBetween = 8;  // samples per frame interval for the peak
+    for (int axis = 0; axis < 3; ++axis) {
+      peak_[axis] = 0.0;
+      for (int k = 0; k <= (frames - 1) * kBetween; ++k)
+        peak_[axis] = std::max(peak_[axis], std::abs(waves[axis].at(k / (kBetween * rate) / tau)));
+    }
+  }
+
+  Eigen::Vector3d at(double time) const {
+    Eigen::Vector3d angles = Eigen::Vector3d::Zero();
+    for (int axis = 0; axis < 3; ++axis)
+      if (peak_[axis] > 0.0)
+        angles[axis] = amplitude_[axis] * waves_[axis].at(time / tau_) / peak_[axis];
+    return angles;
+  }
+
+ private:
+  std::array<Wave, 3> waves_;
+  Eigen::Vector3d amplitude_;
+  double tau_ = 1.0, peak_[3] = {};
+};
+
+// The angles of every frame.
 std::vector<Eigen::Vector3d> pan_angles(const std::array<Wave, 3>& waves,
                                         const Eigen::Vector3d& amplitude, int frames, double rate,
                                         double tau) {
-  constexpr int kBetween = 8;  // samples per frame interval for the peak
-  std::vector<Eigen::Vector3d> angles(frames, Eigen::Vector3d::Zero());
-  for (int axis = 0; axis < 3; ++axis) {
-    double peak = 0.0;
-    for (int k = 0; k <= (frames - 1) * kBetween; ++k)
-      peak = std::max(peak, std::abs(waves[axis].at(k / (kBetween * rate) / tau)));
-    for (int i = 0; i < frames; ++i)
-      angles[i][axis] = peak > 0.0 ? amplitude[axis] * waves[axis].at(i / rate / tau) / peak : 0.0;
-  }
+  const PanAngles angles_at(waves, amplitude, frames, rate, tau);
+  std::vector<Eigen::Vector3d> angles;
+  for (int i = 0; i < frames; ++i) angles.push_back(angles_at.at(i / rate));
   return angles;
 }
 
@@ -82,6 +104,11 @@ Eigen::Matrix3d pan_rotation(double yaw_deg, double pitch_deg, double roll_deg) 
           Eigen::AngleAxisd(pitch_deg * kDeg, Eigen::Vector3d::UnitX()) *
           Eigen::AngleAxisd(roll_deg * kDeg, Eigen::Vector3d::UnitZ()))
       .toRotationMatrix();
+}
+
+Eigen::Matrix3d PanMotion::R_neutral_from_camera_at(double time) const {
+  const Eigen::Vector3d a = yaw_pitch_roll_deg_at(time);
+  return pan_rotation(a.x(), a.y(), a.z());
 }
 
 double rotation_step_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
@@ -139,6 +166,8 @@ PanMotion make_pan_motion(const PanMotionOptions& o) {
           rotation_step_deg(pan.R_neutral_from_camera[i - 1], pan.R_neutral_from_camera[i]));
   }
   pan.max_step_deg = fastest;
+  const PanAngles angles_at(waves, amplitude, o.frames, o.rate, slow);
+  pan.yaw_pitch_roll_deg_at = [angles_at](double time) { return angles_at.at(time); };
   return pan;
 }
 

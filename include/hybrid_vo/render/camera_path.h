@@ -5,6 +5,7 @@
 // standing still, turning in place, or starting to walk from rest. Poses are camera-to-world.
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,9 @@ struct Trajectory {
   std::vector<double> times;      // seconds since frame 0: i / rate
   double length = 0.0;            // metres travelled by the camera centre
   double total_turn_deg = 0.0;    // sum of |heading change| between frames (without the wobble)
+  // The path between and beyond the frames: the pose at any time (seconds since frame 0), the
+  // frames' own at theirs. Motion blur samples it within a frame's exposure.
+  std::function<CameraPose(double time)> pose_at;
 };
 
 // Throws std::invalid_argument for invalid options, and for a turn whose circle leaves the

@@ -7,6 +7,7 @@
 // near the maximum. Rotations are of the camera's optical frame (x right, y down, z forward).
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -32,12 +33,16 @@ struct PanMotion {
   std::vector<Eigen::Vector3d> yaw_pitch_roll_deg;
   std::vector<double> times;                      // seconds: i / rate
   double min_step_deg = 0.0, max_step_deg = 0.0;  // between consecutive frames
+  // The pan between and beyond the frames: the angles at any time (seconds since frame 0), the
+  // frames' own at theirs. Motion blur samples it within a frame's exposure.
+  std::function<Eigen::Vector3d(double time)> yaw_pitch_roll_deg_at;
 
   // Frame i's orientation in the first frame's camera, the ground truth's world (camera to
   // first); the centre stays at its origin.
   Eigen::Matrix3d R_first_from_camera(int frame) const {
     return R_neutral_from_camera.front().transpose() * R_neutral_from_camera.at(frame);
   }
+  Eigen::Matrix3d R_neutral_from_camera_at(double time) const;
 };
 
 // Throws std::invalid_argument for fewer than 2 frames, a rate, amplitude or step that is not
