@@ -17,6 +17,7 @@
 #include "file_test_utils.h"
 #include "hybrid_vo/datasets/kitti_writer.h"
 #include "hybrid_vo/datasets/readers.h"
+#include "hybrid_vo/render/imaging.h"
 #include "hybrid_vo/render/pan_motion.h"
 #include "hybrid_vo/render/pan_options.h"
 #include "hybrid_vo/render/photo_pan.h"
@@ -127,6 +128,105 @@ TEST(PhotoPan, NoiseDiffersPerFrameAndRepeats) {
   const double mean_change = cv::norm(a, c, cv::NORM_L1) / a.total();
   EXPECT_GT(mean_change, 1.5);  // two noises of sigma 2: 2.26 apart on average
   EXPECT_LT(mean_change, 3.0);
+}
+
+// The sum of squared gradients: lower where the image is smeared.
+double gradient_energy(const cv::Mat& image) {
+  cv::Mat gx, gy;
+  cv::Sobel(image, gx, CV_32F, 1, 0);
+  cv::Sobel(image, gy, CV_32F, 0, 1);
+  return cv::norm(gx, cv::NORM_L2SQR) + cv::norm(gy, cv::NORM_L2SQR);
+}
+
+TEST(PhotoPan, CleanFramesAreTheInstantsViews) {
+  PanMotionOptions options;
+  options.frames = 20;
+  const PanMotion motion = make_pan_motion(options);
+  const PhotoPan pan(marked_photo(), kPhoto, kCamera, 1.0, 3);
+  for (int i : {0, 7, 19}) {
+    ASSERT_EQ(pan.exposure_rotations(motion, i).size(), 1u);
+    EXPECT_EQ(cv::norm(pan.render_frame(motion, i), pan.render(motion.R_neutral_from_camera[i], i),
+                       cv::NORM_INF),
+              0.0);
+  }
+}
+
+// A 20 ms exposure at the pan's fastest frame: the views at the pan's rotations around the
+// frame's, consecutive ones within a pixel, smear the marks; a pan that hardly moves is one view
+// per exposure.
+TEST(PhotoPan, AnExposureBlursAlongThePanAroundTheFramesRotation) {
+  PanMotionOptions options;
+  options.frames = 60;
+  const PanMotion motion = make_pan_motion(options);
+  ImagingOptions imaging;
+  imaging.exposure_ms = 20.0;
+  imaging.max_exposure_samples = 15;
+  const PhotoPan sharp(marked_photo(), kPhoto, kCamera, 0.0, 1);
+  const PhotoPan blurred(marked_photo(), kPhoto, kCamera, 0.0, 1, imaging);
+  int fastest = 1, slowest = 1;
+  auto step = [&](int i) {
+    return rotation_step_deg(motion.R_neutral_from_camera[i - 1], motion.R_neutral_from_camera[i]);
+  };
+  for (int i = 1; i < options.frames; ++i) {
+    if (step(i) > step(fastest)) fastest = i;
+    if (step(i) < step(slowest)) slowest = i;
+  }
+  const std::vector<Eigen::Matrix3d> rotations = blurred.exposure_rotations(motion, fastest);
+  const size_t n = rotations.size();
+  ASSERT_EQ(n % 2, 1u);
+  EXPECT_EQ(rotations[n / 2], motion.R_neutral_from_camera[fastest]);
+  const double t = motion.times[fastest], half = 0.010 * (n - 1.0) / n;
+  EXPECT_LT(rotation_step_deg(rotations.front(), motion.R_neutral_from_camera_at(t - half)), 1e-9);
+  EXPECT_LT(rotation_step_deg(rotations.back(), motion.R_neutral_from_camera_at(t + half)), 1e-9);
+  const double moved = pan_motion_px(kCamera, motion.R_neutral_from_camera_at(t - 0.010),
+                                     motion.R_neutral_from_camera_at(t + 0.010));
+  // About 1.3 deg per frame at 30 Hz: 0.78 deg in 20 ms, 7 pixels at f = 500.
+  EXPECT_GT(moved, 5.0);
+  EXPECT_GE(static_cast<double>(n), moved);
+  const cv::Mat instant = sharp.render_frame(motion, fastest);
+  const cv::Mat smeared = blurred.render_frame(motion, fastest);
+  EXPECT_LT(gradient_energy(smeared), 0.6 * gradient_energy(instant));
+  EXPECT_NEAR(cv::mean(smeared)[0], cv::mean(instant)[0], 0.5);
+
+  // Slower where it turns back: fewer views.
+  EXPECT_LT(blurred.exposure_rotations(motion, slowest).size(), n);
+
+  // A pan too slow to move the image by a pixel in the exposure is not blurred.
+  options.max_step_deg = 0.02;
+  const PanMotion creeping = make_pan_motion(options);
+  for (int i : {0, 30, 59}) {
+    EXPECT_EQ(blurred.exposure_rotations(creeping, i).size(), 1u);
+    EXPECT_EQ(cv::norm(blurred.render_frame(creeping, i), sharp.render_frame(creeping, i),
+                       cv::NORM_INF),
+              0.0);
+  }
+}
+
+TEST(PhotoPan, ExposureGainAndVignettingReachThePan) {
+  PanMotionOptions options;
+  options.frames = 40;
+  const PanMotion motion = make_pan_motion(options);
+  ImagingOptions imaging;
+  imaging.exposure_drift = 0.15;
+  // Noise dithers the rounding of the dark background.
+  const PhotoPan fixed(marked_photo(), kPhoto, kCamera, 2.0, 1);
+  const PhotoPan drifting(marked_photo(), kPhoto, kCamera, 2.0, 1, imaging);
+  for (int i : {0, 20, 39}) {
+    const double ratio =
+        cv::mean(drifting.render_frame(motion, i))[0] / cv::mean(fixed.render_frame(motion, i))[0];
+    EXPECT_NEAR(ratio, exposure_gain(0.15, 1, motion.times[i]), 0.01) << i;
+  }
+  imaging = ImagingOptions();
+  imaging.vignetting = 0.35;
+  const cv::Mat dark = PhotoPan(marked_photo(), kPhoto, kCamera, 0.0, 1, imaging)
+                           .render(Eigen::Matrix3d::Identity(), 0);
+  const cv::Mat plain = PhotoPan(marked_photo(), kPhoto, kCamera, 0.0, 1)
+                            .render(Eigen::Matrix3d::Identity(), 0);
+  // The photograph's dark background is 20 grey levels: 13 in the corners.
+  EXPECT_NEAR(dark.at<uchar>(0, 0), 0.65 * plain.at<uchar>(0, 0), 1.0);
+  EXPECT_EQ(dark.at<uchar>(120, 160), plain.at<uchar>(120, 160));
+  imaging.vignetting = 1.0;
+  EXPECT_THROW(PhotoPan(marked_photo(), kPhoto, kCamera, 0.0, 1, imaging), std::invalid_argument);
 }
 
 TEST(PhotoPan, ViewsLeavingThePhotographAreFound) {
@@ -261,6 +361,24 @@ TEST(PanMotion, SeedsAndOptionsChangeIt) {
         with([](PanMotionOptions& p) { p.max_step_deg = HUGE_VAL; }),
         with([](PanMotionOptions& p) { p.yaw_deg = p.pitch_deg = p.roll_deg = 0.0; })})
     EXPECT_THROW(make_pan_motion(bad), std::invalid_argument);
+}
+
+TEST(PanMotion, ThePanBetweenTheFramesPassesThroughThem) {
+  PanMotionOptions options;
+  options.frames = 50;
+  const PanMotion pan = make_pan_motion(options);
+  for (int i = 0; i < options.frames; ++i) {
+    EXPECT_EQ(pan.yaw_pitch_roll_deg_at(pan.times[i]), pan.yaw_pitch_roll_deg[i]) << i;
+    EXPECT_EQ(pan.R_neutral_from_camera_at(pan.times[i]), pan.R_neutral_from_camera[i]) << i;
+  }
+  // Half way between two frames it is half way, near enough (the pan is smooth).
+  for (int i = 1; i < options.frames; ++i) {
+    const Eigen::Matrix3d middle = pan.R_neutral_from_camera_at(0.5 * (pan.times[i - 1] +
+                                                                        pan.times[i]));
+    const double step = rotation_step_deg(pan.R_neutral_from_camera[i - 1],
+                                          pan.R_neutral_from_camera[i]);
+    EXPECT_NEAR(rotation_step_deg(pan.R_neutral_from_camera[i - 1], middle), 0.5 * step, 0.05);
+  }
 }
 
 TEST(PanMotion, DropEveryLeavesOutEveryNthFrame) {
@@ -419,6 +537,32 @@ TEST(PanOptions, ArgumentsAreParsedAndBadOnesRejected) {
   PanOptions help;
   EXPECT_EQ(parse_pan_args({"--help"}, &help), "");
   EXPECT_TRUE(help.help);
+
+  // The imaging options, as hybrid_vo_render_sequence's.
+  PanOptions realistic;
+  ASSERT_EQ(parse_pan_args({"--photo", "p.jpg", "--kitti-dir", "/tmp/k", "--imaging", "realistic",
+                            "--jpeg-artefacts", "60"},
+                           &realistic),
+            "");
+  EXPECT_EQ(realistic.imaging.exposure_ms, 10.0);
+  EXPECT_EQ(realistic.imaging.vignetting, 0.35);
+  EXPECT_EQ(realistic.imaging.jpeg_quality, 60);
+  EXPECT_EQ(realistic.noise, kRealisticReadNoise);
+  PanOptions clean;
+  ASSERT_EQ(parse_pan_args({"--photo", "p.jpg", "--kitti-dir", "/tmp/k"}, &clean), "");
+  EXPECT_EQ(describe(clean.imaging), "clean");
+  EXPECT_EQ(clean.noise, 1.0);
+  PanOptions slow;
+  EXPECT_TRUE(contains(parse_pan_args({"--photo", "p.jpg", "--kitti-dir", "/tmp/k",
+                                       "--exposure-ms", "40"},
+                                      &slow),
+                       "--exposure-ms 40 is longer than a frame at 30 Hz"));
+  EXPECT_TRUE(contains(parse_pan_args({"--photo", "p.jpg", "--kitti-dir", "/tmp/k",
+                                       "--vignetting", "-0.1"},
+                                      &slow),
+                       "bad value '-0.1' for --vignetting"));
+  EXPECT_TRUE(contains(pan_usage("pan"), "--imaging clean|realistic"));
+  EXPECT_TRUE(contains(pan_usage("pan"), "--jpeg-artefacts"));
 }
 
 }  // namespace

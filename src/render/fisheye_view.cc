@@ -1,4 +1,5 @@
-#include "fisheye_view.h"
+#include "view_radiance.h"
+#include "shading.h"
 
 #include <algorithm>
 #include <array>
@@ -7,8 +8,6 @@
 #include <vector>
 
 #include <opencv2/core/utility.hpp>
-
-#include "shading.h"
 
 namespace hybrid_vo {
 namespace render {
@@ -170,8 +169,9 @@ SampleGrid rasterize(const Scene& scene, const CameraModel& camera, const Camera
 
 }  // namespace
 
-RenderedView render_equidistant_view(const Scene& scene, const CameraModel& camera,
-                                     const CameraPose& pose, const RenderOptions& o) {
+ViewRadiance equidistant_radiance(const Scene& scene, const CameraModel& camera,
+                                  const CameraPose& pose, const RenderOptions& o,
+                                  bool with_geometry) {
   const PinholeCamera& cam = camera.pinhole;
   check(camera.model == LensModel::kEquidistant && camera_model_problem(camera).empty() &&
             cam.width >= 1 && cam.height >= 1 && cam.width <= 8192 && cam.height <= 8192,
@@ -215,8 +215,9 @@ RenderedView render_equidistant_view(const Scene& scene, const CameraModel& came
     }
   });
 
-  RenderedView view;
-  view.image = finish(radiance, o);
+  ViewRadiance view;
+  view.radiance = radiance;
+  if (!with_geometry) return view;
   // Depth and quad at the pixel centres: the middle sample for odd ss, else one more pass.
   const bool odd = ss % 2 == 1;
   const SampleRays centre_rays = odd ? SampleRays() : sample_rays(camera, 1);

@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "imaging_arguments.h"
 #include "number_arguments.h"
 
 namespace hybrid_vo {
@@ -53,18 +54,28 @@ std::string pan_usage(const std::string& program) {
     << "                     is set so that it reaches it, and slows down where it reverses\n"
     << "  --drop-every N     leave out every N-th frame (N >= 2), as a busy machine drops them\n"
     << "                     (default 0: none); the others keep their true stamps\n"
-    << "  --noise SIGMA      image noise in grey levels (default 1)\n"
+    << imaging_usage()
     << "  --compression none|lz4|bz2  bag compression (default lz4)\n";
   return s.str();
 }
 
 std::string parse_pan_args(const std::vector<std::string>& args, PanOptions* o) {
+  ImagingArguments imaging;
+  bool noise_given = false;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg == "--help" || arg == "-h") {
       o->help = true;
       return "";
     }
+    if (is_imaging_option(arg)) {
+      if (i + 1 >= args.size()) return arg + " needs a value";
+      if (!parse_imaging_option(arg, args[i + 1], &imaging))
+        return "bad value '" + args[i + 1] + "' for " + arg;
+      ++i;
+      continue;
+    }
+    noise_given = noise_given || arg == "--noise";
     static const char* kValued[] = {
         "--photo",        "--camera",     "--K",       "--out",        "--kitti-dir",
         "--kitti-name",   "--width",      "--height",  "--focal",      "--frames",
@@ -125,6 +136,7 @@ std::string parse_pan_args(const std::vector<std::string>& args, PanOptions* o) 
     }
     if (!ok) return "bad value '" + v + "' for " + arg;
   }
+  o->imaging = resolve_imaging(imaging, noise_given, &o->noise);
   if (o->photo.empty()) return "--photo PHOTO is required";
   if (o->out_bag.empty() && o->kitti_dir.empty())
     return "--out OUT.bag or --kitti-dir DIR is required";
@@ -132,7 +144,7 @@ std::string parse_pan_args(const std::vector<std::string>& args, PanOptions* o) 
     return "--camera and --K exclude each other (both give the photograph's intrinsics)";
   if (o->motion.yaw_deg == 0.0 && o->motion.pitch_deg == 0.0 && o->motion.roll_deg == 0.0)
     return "--yaw-deg, --pitch-deg and --roll-deg are all 0: no pan";
-  return "";
+  return imaging_rate_problem(o->imaging, o->motion.rate);
 }
 
 PinholeCamera pan_camera(const PanOptions& o) {

@@ -1,7 +1,8 @@
 #include "hybrid_vo/render/renderer.h"
 
-#include "fisheye_view.h"
+#include "hybrid_vo/render/imaging.h"
 #include "shading.h"
+#include "view_radiance.h"
 
 #include <algorithm>
 #include <array>
@@ -127,10 +128,7 @@ PinholeCamera default_camera(int width, int height) {
 
 RenderedView render_view(const Scene& scene, const CameraModel& camera, const CameraPose& pose,
                          const RenderOptions& options) {
-  if (camera.model == LensModel::kEquidistant)
-    return render_equidistant_view(scene, camera, pose, options);
-  check(!camera.has_distortion(), "only pinhole and equidistant cameras are rendered");
-  return render_view(scene, camera.pinhole, pose, options);
+  return render_exposure(scene, camera, {pose}, options);
 }
 
 CameraModel fisheye_camera(double fov_deg, int width, int height) {
@@ -166,8 +164,18 @@ int cast_ray(const Scene& scene, const Eigen::Vector3d& origin, const Eigen::Vec
   return hit;
 }
 
-RenderedView render_view(const Scene& scene, const PinholeCamera& cam, const CameraPose& pose,
-                         const RenderOptions& o) {
+RenderedView render_view(const Scene& scene, const PinholeCamera& camera, const CameraPose& pose,
+                         const RenderOptions& options) {
+  ViewRadiance v = pinhole_radiance(scene, camera, pose, options, true);
+  RenderedView view;
+  view.image = sensor_image(v.radiance, options);
+  view.depth = v.depth;
+  view.quad_id = v.quad_id;
+  return view;
+}
+
+ViewRadiance pinhole_radiance(const Scene& scene, const PinholeCamera& cam, const CameraPose& pose,
+                              const RenderOptions& o, bool with_geometry) {
   check(cam.valid() && cam.width >= 1 && cam.height >= 1 && cam.width <= 8192 && cam.height <= 8192,
         "the camera needs valid intrinsics and a size in [1, 8192]");
   check_render_inputs(o, pose);
@@ -213,8 +221,9 @@ RenderedView render_view(const Scene& scene, const PinholeCamera& cam, const Cam
     }
   });
 
-  RenderedView view;
-  view.image = finish(radiance, o);
+  ViewRadiance view;
+  view.radiance = radiance;
+  if (!with_geometry) return view;
 
   // Depth and quad at the pixel centres: the middle sample for odd ss, else one more pass.
   const SampleGrid centres = ss % 2 == 1 ? SampleGrid() : rasterize(scene, cam, pose, 1, o.near);

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "imaging_arguments.h"
 #include "number_arguments.h"
 #include "painter.h"
 
@@ -47,11 +48,11 @@ std::string sequence_usage(const std::string& program) {
     << "  --focal PX         focal length (default 0.72 * width)\n"
     << "  --fisheye-fov DEG  an equidistant (fisheye) lens of this horizontal field of view\n"
     << "                     instead of the pinhole (camera_info distortion_model equidistant)\n"
-    << "  --noise SIGMA      image noise in grey levels (default 1)\n"
     << "  --supersampling K  K x K rays per pixel (default 3)\n"
     << "  --compression none|lz4|bz2  bag compression (default lz4)\n"
     << "  --compressed png|jpeg  images as sensor_msgs/CompressedImage on .../image_raw/compressed\n"
     << "  --jpeg-quality Q   with --compressed jpeg: quality 1..100 (default 95)\n"
+    << imaging_usage()
     << "  --png-dir DIR      also write the images as PNG files\n"
     << "  --kitti-dir DIR    also write DIR/sequences/NAME/{image_0,image_1,calib.txt,times.txt}\n"
     << "                     and DIR/poses/NAME.txt (left camera-to-world in the scene's world)\n"
@@ -61,6 +62,8 @@ std::string sequence_usage(const std::string& program) {
 
 std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOptions* o) {
   std::vector<std::string> motion_options;  // given, to check against the motion at the end
+  ImagingArguments imaging;
+  bool noise_given = false;
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg == "--help" || arg == "-h") {
@@ -76,6 +79,14 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       motion_options.push_back(arg);
       continue;
     }
+    if (is_imaging_option(arg)) {
+      if (i + 1 >= args.size()) return arg + " needs a value";
+      if (!parse_imaging_option(arg, args[i + 1], &imaging))
+        return "bad value '" + args[i + 1] + "' for " + arg;
+      ++i;
+      continue;
+    }
+    noise_given = noise_given || arg == "--noise";
     static const char* kValued[] = {"--out",           "--png-dir",    "--frames", "--width",
                                     "--height",        "--rate",       "--seed",   "--scene",
                                     "--baseline",      "--speed",      "--focal",  "--noise",
@@ -154,8 +165,11 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       motion_options.push_back(arg);
     if (!ok) return "bad value '" + v + "' for " + arg;
   }
+  o->imaging = resolve_imaging(imaging, noise_given, &o->noise);
   if (o->out_bag.empty() && o->kitti_dir.empty())
     return "--out OUT.bag or --kitti-dir DIR is required";
+  if (const std::string problem = imaging_rate_problem(o->imaging, o->rate); !problem.empty())
+    return problem;
   if (o->focal > 0.0 && o->fisheye_fov > 0.0)
     return "--focal and --fisheye-fov exclude each other (the field of view sets the focal)";
   if (!o->kitti_dir.empty() && o->fisheye_fov > 0.0)
@@ -226,6 +240,11 @@ Sequence make_sequence(const SequenceOptions& options) {
   }
   seq.render.supersampling = options.supersampling;
   seq.render.noise_sigma = options.noise;
+  if (const std::string problem = imaging_problem(options.imaging); !problem.empty())
+    throw std::invalid_argument("render sequence: " + problem);
+  seq.render.vignetting = options.imaging.vignetting;
+  seq.render.shot_noise_gain = options.imaging.shot_noise_gain;
+  seq.render.jpeg_quality = options.imaging.jpeg_quality;
   if (options.stereo && !(options.baseline > 0.0))
     throw std::invalid_argument("render sequence: the stereo baseline must be positive");
   return seq;
@@ -238,11 +257,33 @@ CameraPose frame_pose(const Sequence& seq, int frame, bool right) {
   return right ? stereo_right(left, seq.options.baseline) : left;
 }
 
+std::vector<CameraPose> exposure_poses(const Sequence& seq, int frame, bool right) {
+  const CameraPose pose = frame_pose(seq, frame, right);
+  const ImagingOptions& imaging = seq.options.imaging;
+  if (!(imaging.exposure_ms > 0.0)) return {pose};
+  const double exposure = 1e-3 * imaging.exposure_ms, time = seq.trajectory.times[frame];
+  auto pose_at = [&](double offset) {
+    if (offset == 0.0) return pose;
+    const CameraPose left = seq.trajectory.pose_at(time + offset);
+    return right ? stereo_right(left, seq.options.baseline) : left;
+  };
+  const double motion = image_motion_px(seq.scene, seq.lens, pose_at(-0.5 * exposure),
+                                        pose_at(0.5 * exposure));
+  std::vector<CameraPose> poses;
+  for (double offset :
+       exposure_offsets(exposure, exposure_samples(motion, imaging.max_exposure_samples)))
+    poses.push_back(pose_at(offset));
+  return poses;
+}
+
 RenderedView render_frame(const Sequence& seq, int frame, bool right) {
   RenderOptions render = seq.render;
   render.noise_seed =
       hash_mix(seq.options.seed, 2 * static_cast<uint64_t>(frame) + (right ? 1 : 0));
-  return render_view(seq.scene, seq.lens, frame_pose(seq, frame, right), render);
+  // One gain for both cameras of the pair, as one auto exposure drives both.
+  render.exposure *= exposure_gain(seq.options.imaging.exposure_drift, seq.options.seed,
+                                   seq.trajectory.times.at(frame));
+  return render_exposure(seq.scene, seq.lens, exposure_poses(seq, frame, right), render);
 }
 
 }  // namespace render

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <opencv2/imgproc.hpp>
 
 namespace hybrid_vo {
 namespace render {
@@ -22,6 +21,11 @@ void check_render_inputs(const RenderOptions& o, const CameraPose& pose) {
   check(o.max_anisotropy >= 1 && o.max_anisotropy <= 16, "max_anisotropy must be in [1, 16]");
   check(std::isfinite(o.exposure) && o.exposure > 0.0, "exposure must be positive");
   check(std::isfinite(o.near) && o.near > 0.0, "near must be positive");
+  check(std::isfinite(o.vignetting) && o.vignetting >= 0.0 && o.vignetting < 1.0,
+        "vignetting must be in [0, 1)");
+  check(std::isfinite(o.shot_noise_gain) && o.shot_noise_gain >= 0.0 && o.shot_noise_gain <= 10.0,
+        "shot_noise_gain must be in [0, 10]");
+  check(o.jpeg_quality >= 0 && o.jpeg_quality <= 100, "jpeg_quality must be in [0, 100]");
   check(pose.R_world_from_camera.allFinite() && pose.centre.allFinite() &&
             (pose.R_world_from_camera.transpose() * pose.R_world_from_camera -
              Eigen::Matrix3d::Identity())
@@ -87,21 +91,6 @@ double shade(const Quad& q, const Eigen::Vector2d& uv, const Eigen::Vector3d& dX
   const double lpm = q.lightmap_per_metre;
   const double light = bilinear(q.lightmap, uv.x() * lpm - 0.5, uv.y() * lpm - 0.5);
   return albedo * light;
-}
-
-cv::Mat finish(cv::Mat radiance, const RenderOptions& o) {
-  if (o.blur_sigma > 0.0)
-    cv::GaussianBlur(radiance, radiance, cv::Size(0, 0), o.blur_sigma, o.blur_sigma,
-                     cv::BORDER_REFLECT);
-  if (o.noise_sigma > 0.0) {
-    cv::Mat noise(radiance.size(), CV_32FC1);
-    cv::RNG rng(o.noise_seed * 0x9E3779B97F4A7C15ull + 1);
-    rng.fill(noise, cv::RNG::NORMAL, 0.0, o.noise_sigma);
-    radiance += noise;
-  }
-  cv::Mat image;
-  radiance.convertTo(image, CV_8U);
-  return image;
 }
 
 bool quad_plane(const Scene& scene, int index, const Eigen::Vector3d& centre, QuadRaster* r) {

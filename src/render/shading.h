@@ -1,8 +1,8 @@
 #pragma once
 
 // What the renderer's cameras share (renderer.cc: pinhole, fisheye_view.cc: equidistant): the
-// checks of the options and pose, the shading of a ray's hit on a quad, and the finishing of the
-// radiance into the 8-bit image.
+// checks of the options and pose, and the shading of a ray's hit on a quad (the sensor that
+// finishes the image is imaging.h's sensor_image).
 
 #include <string>
 
@@ -49,9 +49,6 @@ struct QuadRaster {
 // The plane and extent of quad `index` of `scene` (not its box); false when a camera at `centre`
 // is behind it (quads are one-sided: seen from the side their normal points to).
 bool quad_plane(const Scene& scene, int index, const Eigen::Vector3d& centre, QuadRaster* r);
-
-// The sensor: blur, noise and 8-bit quantisation of a CV_32FC1 radiance image.
-cv::Mat finish(cv::Mat radiance, const RenderOptions& options);
 
 }  // namespace render
 }  // namespace hybrid_vo

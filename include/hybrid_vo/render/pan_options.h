@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hybrid_vo/geometry/camera.h"
+#include "hybrid_vo/render/imaging.h"
 #include "hybrid_vo/render/pan_motion.h"
 
 namespace hybrid_vo {
@@ -26,7 +27,8 @@ struct PanOptions {
   std::string compression = "lz4";  // none, lz4 or bz2
   int width = 640, height = 480;
   double focal = 1000.0;  // pixels; principal point at the image centre
-  double noise = 1.0;     // grey levels
+  double noise = 1.0;     // grey levels: the read noise (constant), 1.5 by --imaging realistic
+  ImagingOptions imaging;  // clean by default
   PanMotionOptions motion;
   int drop_every = 0;  // 0: every frame
   bool help = false;

@@ -6,10 +6,13 @@
 // Every pixel averages ss x ss rays (box filter) whose hits are found exactly, so geometric
 // edges are antialiased; textures are sampled with anisotropic trilinear mip-mapping at each
 // ray's footprint, so distant tiles do not alias into fake corners. A slight Gaussian blur
-// stands in for the optics and Gaussian noise for the sensor. Pixel centres sit at integer
-// coordinates (OpenCV's and ROS's convention): pixel (x, y) sees the ray through K^-1 (x, y, 1).
+// stands in for the optics and Gaussian noise for the sensor; a realistic camera's vignetting,
+// signal-dependent noise, JPEG (imaging.h) and motion blur (render_exposure) are there on demand.
+// Pixel centres sit at integer coordinates (OpenCV's and ROS's convention): pixel (x, y) sees the
+// ray through K^-1 (x, y, 1).
 
 #include <cstdint>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -29,6 +32,10 @@ struct RenderOptions {
   int max_anisotropy = 4;    // texture taps along the footprint's long axis (1..16)
   double exposure = 1.0;     // grey = 255 * exposure * albedo * irradiance, clamped
   double near = 0.05;        // metres; nearer surfaces are not drawn
+  // A realistic sensor's (imaging.h); 0: none, the clean renders'.
+  double vignetting = 0.0;       // how much darker the corners are (fraction)
+  double shot_noise_gain = 0.0;  // noise variance per grey level of signal, beside noise_sigma^2
+  int jpeg_quality = 0;          // 1..100: the image JPEG-coded at this quality
 };
 
 struct RenderedView {
@@ -49,6 +56,19 @@ RenderedView render_view(const Scene& scene, const PinholeCamera& camera, const 
 // distortions are refused (std::invalid_argument), as are lens coefficients that fold back.
 RenderedView render_view(const Scene& scene, const CameraModel& camera, const CameraPose& pose,
                          const RenderOptions& options = {});
+
+// The view integrated over an exposure: the radiance of the camera at each of `poses` (the
+// exposure's instants, an odd number of them), averaged, then the sensor. The middle pose is the
+// view's own: its depth and quad ids are the view's, and one pose is render_view. Throws as
+// render_view, and for an even number of poses.
+RenderedView render_exposure(const Scene& scene, const CameraModel& camera,
+                             const std::vector<CameraPose>& poses, const RenderOptions& options = {});
+
+// How far the image moves, at most, from a camera at `from` to one at `to` (pixels): the scene
+// points seen at a grid of pixels from `to` (far away where nothing is hit), projected into
+// `from`. What motion blur needs to know to sample an exposure.
+double image_motion_px(const Scene& scene, const CameraModel& camera, const CameraPose& from,
+                       const CameraPose& to);
 
 // The renderer's fisheye for a width x height image: an equidistant lens whose horizontal field
 // of view is fov_deg across the image (to its outer edges), principal point at the centre,

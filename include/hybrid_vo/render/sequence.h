@@ -10,6 +10,7 @@
 
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/render/camera_path.h"
+#include "hybrid_vo/render/imaging.h"
 #include "hybrid_vo/render/renderer.h"
 #include "hybrid_vo/render/scene.h"
 
@@ -47,7 +48,8 @@ struct SequenceOptions {
   // > 0: an equidistant (fisheye) lens of this horizontal field of view in degrees
   // (fisheye_camera), instead of the pinhole.
   double fisheye_fov = 0.0;
-  double noise = 1.0;      // grey levels
+  double noise = 1.0;      // grey levels: the read noise (constant), 1.5 by --imaging realistic
+  ImagingOptions imaging;  // clean by default
   int supersampling = 3;
   std::string compression = "lz4";  // none, lz4 or bz2
   std::string compressed_images;    // empty: raw images; png or jpeg: CompressedImage topics
@@ -80,8 +82,13 @@ struct Sequence {
 Sequence make_sequence(const SequenceOptions& options);
 
 // Renders frame i of the left camera, or of the right one (stereo: centre shifted by the
-// baseline along the left camera's x axis). The noise differs per frame and camera.
+// baseline along the left camera's x axis). The noise differs per frame and camera. With an
+// exposure (options.imaging), the views along the path over the exposure are averaged, as many
+// as keep consecutive ones within a pixel: the frame's pose, its ground truth, is the middle of
+// the exposure.
 RenderedView render_frame(const Sequence& sequence, int frame, bool right = false);
+// The camera's poses that frame i integrates over (odd in number, the middle one frame_pose).
+std::vector<CameraPose> exposure_poses(const Sequence& sequence, int frame, bool right = false);
 CameraPose frame_pose(const Sequence& sequence, int frame, bool right = false);
 
 }  // namespace render
