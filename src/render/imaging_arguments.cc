@@ -59,15 +59,16 @@ std::string imaging_rate_problem(const ImagingOptions& imaging, double rate_hz) 
   const double frame_ms = 1000.0 / rate_hz;
   if (imaging.exposure_ms <= frame_ms) return "";
   char text[160];
-  std::snprintf(text, sizeof(text), "--exposure-ms %g is longer than a frame at %g Hz (%g ms)",
+  std::snprintf(text, sizeof(text), "--exposure-ms %g is longer than a frame at %g Hz (%.4g ms)",
                 imaging.exposure_ms, rate_hz, frame_ms);
   return text;
 }
 
 std::string imaging_usage() {
   return "  --imaging clean|realistic  how the camera makes its images (default clean: a slight\n"
-         "                     blur and constant noise); realistic: a camera's, with the\n"
-         "                     defaults in brackets below, each of which may be given alone\n"
+         "                     blur and constant noise); realistic: a real camera's, the\n"
+         "                     knobs below at their 'realistic' values; each knob may also be\n"
+         "                     given alone, or after --imaging realistic to change it\n"
          "  --exposure-ms MS   motion blur: the views over an exposure of MS ms around each\n"
          "                     frame's stamp, averaged (realistic 10; the ground truth is the\n"
          "                     middle of the exposure)\n"
