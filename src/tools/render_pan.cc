@@ -100,20 +100,25 @@ int main(int argc, char** argv) {
     }
     const PinholeCamera camera = pan_camera(options);
     const PanMotion motion = make_pan_motion(options.motion);
-    // Every frame's view must lie inside the photograph before anything is written.
-    for (size_t i = 0; i < motion.R_neutral_from_camera.size(); ++i) {
+    const PhotoPan pan(photo, photo_camera, camera, options.noise, options.motion.seed,
+                       options.imaging);
+    // Every frame's views (over its exposure) must lie inside the photograph before anything is
+    // written.
+    for (int i = 0; i < options.motion.frames; ++i) {
       Eigen::Vector2d corner;
-      if (!view_inside_photo(pan_homography(photo_camera, camera, motion.R_neutral_from_camera[i]),
-                             camera, photo_camera, 1.0, &corner)) {
+      bool inside = true;
+      for (const Eigen::Matrix3d& R : pan.exposure_rotations(motion, i))
+        inside = inside && view_inside_photo(pan_homography(photo_camera, camera, R), camera,
+                                             photo_camera, 1.0, &corner);
+      if (!inside) {
         std::fprintf(stderr,
-                     "error: frame %zu's view leaves the %dx%d photograph (a corner lands at "
+                     "error: frame %d's view leaves the %dx%d photograph (a corner lands at "
                      "%.0f, %.0f): smaller --yaw-deg, --pitch-deg, --roll-deg or a longer "
                      "--focal\n",
                      i, photo_camera.width, photo_camera.height, corner.x(), corner.y());
         return 1;
       }
     }
-    const PhotoPan pan(photo, photo_camera, camera, options.noise, options.motion.seed);
 
     conversion::BagOutput out;
     std::string write_error;
@@ -144,9 +149,8 @@ int main(int argc, char** argv) {
     double render_seconds = 0.0;
     for (int i = 0; i < options.motion.frames; ++i) {
       if (is_dropped(i, options.drop_every)) continue;
-      const Eigen::Matrix3d& R = motion.R_neutral_from_camera[i];
       const auto r0 = std::chrono::steady_clock::now();
-      const cv::Mat image = pan.render(R, i);
+      const cv::Mat image = pan.render_frame(motion, i);
       render_seconds +=
           std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
       const Eigen::Matrix3d R_world_from_camera = motion.R_first_from_camera(i);
@@ -182,13 +186,17 @@ int main(int argc, char** argv) {
       outputs +=
           (to_bag ? " and " : "") + kitti.sequence_dir() + " (poses " + kitti.poses_path() + ")";
     const PanMotionOptions& m = options.motion;
+    const std::string imaging = describe(options.imaging) == "clean"
+                                    ? ""
+                                    : "imaging: " + describe(options.imaging) + "; ";
     std::printf(
         "rendered %d of %d frames (%d dropped) from %s: %dx%d, f %.0f px, %.0f Hz; yaw +-%g, "
         "pitch +-%g, roll +-%g deg, %.2f to %.2f deg per frame; prefilter sigma %.2f px; "
-        "%.3f s per frame, %.1f s total -> %s\n",
+        "%s%.3f s per frame, %.1f s total -> %s\n",
         written, m.frames, m.frames - written, options.photo.c_str(), camera.width, camera.height,
         camera.fx, m.rate, m.yaw_deg, m.pitch_deg, m.roll_deg, motion.min_step_deg,
-        motion.max_step_deg, pan.prefilter_sigma(), render_seconds / written, total,
+        motion.max_step_deg, pan.prefilter_sigma(), imaging.c_str(), render_seconds / written,
+        total,
         outputs.c_str());
   } catch (const rosbag::BagException& e) {
     std::cerr << "error: cannot write the bag '" << options.out_bag << "': " << e.what() << "\n";

@@ -102,6 +102,7 @@ int main(int argc, char** argv) {
 
     const double tx_right = -seq.camera.fx * options.baseline;
     double render_seconds = 0.0;
+    size_t exposure_views = 0;
     for (int i = 0; i < seq.options.frames; ++i) {
       const ros::Time t = stamp_of(i, options.rate);
       cv::Mat images[2];
@@ -111,6 +112,7 @@ int main(int argc, char** argv) {
         const RenderedView view = render_frame(seq, i, is_right);
         render_seconds +=
             std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+        exposure_views += exposure_poses(seq, i, is_right).size();
         images[side] = view.image;
         const std::string prefix = conversion::camera_topic(is_right ? "right" : "left");
         const std::string& frame = is_right ? right : left;
@@ -165,8 +167,16 @@ int main(int argc, char** argv) {
     if (to_kitti)
       outputs += (to_bag ? " and " : "") + kitti.sequence_dir() + " (poses " + kitti.poses_path() +
                  ")";
+    std::string imaging;
+    if (describe(options.imaging) != "clean") {
+      char instants[64];
+      std::snprintf(instants, sizeof(instants), " (%.1f instants per view)",
+                    static_cast<double>(exposure_views) / views);
+      imaging = ", imaging: " + describe(options.imaging) +
+                (options.imaging.exposure_ms > 0.0 ? instants : "");
+    }
     std::printf(
-        "rendered %d frames (%s, %dx%d, %s%s, %s%s, %.0f Hz), path %.1f m, turned %.0f deg, "
+        "rendered %d frames (%s, %dx%d, %s%s, %s%s, %.0f Hz%s), path %.1f m, turned %.0f deg, "
         "%.3f s per view, %.1f s total -> %s\n",
         seq.options.frames, options.stereo ? "stereo" : "mono", options.width, options.height,
         options.fisheye_fov > 0.0
@@ -174,7 +184,7 @@ int main(int argc, char** argv) {
                " deg equidistant, ").c_str()
             : "",
         to_string(options.scene), to_string(options.texture),
-        motion.c_str(), options.rate,
+        motion.c_str(), options.rate, imaging.c_str(),
         seq.trajectory.length, seq.trajectory.total_turn_deg, render_seconds / views, total,
         outputs.c_str());
   } catch (const rosbag::BagException& e) {
