@@ -203,6 +203,83 @@ TEST(Replay, RenderedStereoSequence) {
   EXPECT_EQ(direction_keys, static_cast<int>(h.last_vps_.vps.size()));
 }
 
+// A robot standing still (the camera at rest, only its sensor's noise changing): a stereo and a
+// mono node answer every frame after the first with ~odometry and /tf,
+// the orientation within 0.05 degrees of the truth, the stereo position within a centimetre and
+// the mono one where it started; the frames are rotation-only, and /diagnostics counts them.
+TEST(Rest, EveryFrameIsAnsweredAndThePoseStays) {
+  render::SequenceOptions options = small_sequence_options(24, 480, 360);
+  options.stereo = true;
+  options.supersampling = 2;
+  options.motion = render::Motion::kRest;
+  options.seed = 3;
+  const render::Sequence seq = render::make_sequence(options);
+  NodeHarness h;
+  ros::NodeHandle nh;
+  std::map<ros::Time, nav_msgs::Odometry> mono;
+  std::map<ros::Time, MotionEstimate> mono_motions;
+  const ros::Subscriber mono_odometry = nh.subscribe<nav_msgs::Odometry>(
+      "hybrid_vo_mono/odometry", 100,
+      [&](const nav_msgs::Odometry::ConstPtr& o) { mono[o->header.stamp] = *o; });
+  const ros::Subscriber mono_motion = nh.subscribe<MotionEstimate>(
+      "hybrid_vo_mono/relative_pose", 100,
+      [&](const MotionEstimate::ConstPtr& m) { mono_motions[m->header.stamp] = *m; });
+  ASSERT_TRUE(h.wait_for_node({h.right_, h.right_info_}));
+  ASSERT_TRUE(testing::wait_connected({{h.left_, 2}, {h.left_info_, 2}},
+                                      {mono_odometry, mono_motion}));
+  publish_static_camera(&h);
+  h.spin_for(0.5);
+  std::vector<ros::Time> stamps;
+  for (int i = 0; i < options.frames; ++i) {
+    const ros::Time stamp(1.0 + i / options.rate);
+    stamps.push_back(stamp);
+    h.left_.publish(image_of(render::render_frame(seq, i, false).image, stamp,
+                             "camera_left_optical"));
+    h.left_info_.publish(info_of(seq.camera, stamp, "camera_left_optical"));
+    h.right_.publish(image_of(render::render_frame(seq, i, true).image, stamp,
+                              "camera_right_optical"));
+    h.right_info_.publish(
+        info_of(seq.camera, stamp, "camera_right_optical", -seq.camera.fx * options.baseline));
+    ASSERT_TRUE(h.wait_for(stamp)) << "no ~relative_pose for frame " << i;
+    for (int wait = 0; wait < 400 && !mono_motions.count(stamp); ++wait) h.spin_for(0.05);
+    ASSERT_TRUE(mono_motions.count(stamp)) << "no mono ~relative_pose for frame " << i;
+  }
+  h.spin_for(1.0);
+  // Odom is the base at the first frame, and the camera has not moved since.
+  int rotation_only = 0, mono_rotation_only = 0;
+  for (const std::map<ros::Time, nav_msgs::Odometry>* odometry : {&h.odometry_, &mono}) {
+    const bool stereo = odometry == &h.odometry_;
+    for (size_t i = 1; i < stamps.size(); ++i) {
+      const auto it = odometry->find(stamps[i]);
+      ASSERT_TRUE(it != odometry->end()) << (stereo ? "stereo" : "mono") << ": no ~odometry for "
+                                         << "frame " << i;
+      const Eigen::Isometry3d pose = pose_of(it->second);
+      EXPECT_LT(Eigen::AngleAxisd(pose.rotation()).angle() * kDeg, 0.05) << "frame " << i;
+      EXPECT_LT(pose.translation().norm(), stereo ? 0.01 : 1e-9) << "frame " << i;
+      EXPECT_TRUE(is_covariance(covariance_of(it->second.pose.covariance))) << "frame " << i;
+      EXPECT_TRUE(is_covariance(covariance_of(it->second.twist.covariance))) << "frame " << i;
+      const MotionEstimate& m = stereo ? h.motions_.at(stamps[i]) : mono_motions.at(stamps[i]);
+      EXPECT_EQ(m.status, MotionEstimate::STATUS_OK) << m.status_text;
+      (stereo ? rotation_only : mono_rotation_only) += m.rotation_only;
+    }
+  }
+  EXPECT_GE(rotation_only, options.frames - 2);
+  EXPECT_GE(mono_rotation_only, options.frames - 2);
+  // The map's frame at the last stamp too.
+  geometry_msgs::TransformStamped tf;
+  ASSERT_NO_THROW(tf = h.buffer_.lookupTransform("odom", "base_link", stamps.back(),
+                                                 ros::Duration(2.0)));
+  EXPECT_LT(tf2::transformToEigen(tf).translation().norm(), 0.01);
+  // /diagnostics comes once a second: its count may lag the last frames.
+  h.spin_for(1.5);
+  const double counted =
+      diagnostic_value(h.last_odometry_status_, "rotation-only frames (no translation seen)");
+  EXPECT_GE(counted, rotation_only - 10);
+  EXPECT_LE(counted, rotation_only);
+  RecordProperty("rotation_only_frames", std::to_string(rotation_only) + " stereo, " +
+                                             std::to_string(mono_rotation_only) + " mono");
+}
+
 // Features projected from the scene: corners painted on the walls and segments along the walls'
 // Manhattan directions, with stable ids. The images are black, so only these can explain a pose.
 struct RenderedFeatures {

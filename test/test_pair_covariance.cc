@@ -18,6 +18,7 @@ namespace hybrid_vo {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
+using Spread = Eigen::Matrix<double, 5, 5>;
 
 TEST(RotationSpread, WeighsCompetingRotationsByTheirCost) {
   const Eigen::Matrix3d R = rotation_about(Eigen::Vector3d(1, 2, 3).normalized(), 0.3);
@@ -25,14 +26,14 @@ TEST(RotationSpread, WeighsCompetingRotationsByTheirCost) {
   // Two rotations 1 degree either side about x, as cheap as the best: with R itself, a third of
   // the weight each at 1 degree.
   const double a = 1.0 * kDeg;
-  std::vector<RotationHypothesis> two = {
+  std::vector<PoseHypothesis> two = {
       {rotation_about(Eigen::Vector3d::UnitX(), a) * R, 10.0},
       {rotation_about(Eigen::Vector3d::UnitX(), -a) * R, 10.0}};
   const Eigen::Matrix3d spread = rotation_spread(two, R, 10.0, 1.0);
   EXPECT_NEAR(spread(0, 0), 2.0 / 3.0 * a * a, 1e-12);
   EXPECT_NEAR(spread(1, 1), 0.0, 1e-15);
   // Far more costly than the best, at this temperature: nearly nothing.
-  for (RotationHypothesis& h : two) h.cost = 40.0;
+  for (PoseHypothesis& h : two) h.cost = 40.0;
   EXPECT_LT(rotation_spread(two, R, 10.0, 1.0)(0, 0), 1e-9 * a * a);
   // A hotter temperature weighs them in again.
   EXPECT_GT(rotation_spread(two, R, 10.0, 100.0)(0, 0), 0.5 * a * a);
@@ -71,7 +72,8 @@ TEST(PairCovariance, WeighsTheSourcesAndMarginalisesTheDirections) {
   Eigen::Matrix<double, 6, 6> C;
   // Points alone: their covariance times matches / independent, the spread on the rotation.
   InformationSplit split = diagonal_split(0);
-  const Eigen::Matrix3d spread = 2e-4 * Eigen::Matrix3d::Identity();
+  Spread spread = Spread::Zero();
+  spread.topLeftCorner<3, 3>() = 2e-4 * Eigen::Matrix3d::Identity();
   ASSERT_TRUE(pair_covariance(split, spread, 400.0, 0.0, options, &C));
   EXPECT_NEAR(C(0, 0), 4e-4 + 2e-4, 1e-15);
   EXPECT_NEAR(C(3, 3), 4e-4, 1e-15);
@@ -83,15 +85,15 @@ TEST(PairCovariance, WeighsTheSourcesAndMarginalisesTheDirections) {
   split.segment_information(0, 0) = 1e4;
   split.segment_information(0, 5) = split.segment_information(5, 0) = -1e4;
   split.segment_information(5, 5) = 1e4;
-  ASSERT_TRUE(pair_covariance(split, Eigen::Matrix3d::Zero(), 100.0, 10.0, options, &C));
+  ASSERT_TRUE(pair_covariance(split, Spread::Zero(), 100.0, 10.0, options, &C));
   EXPECT_NEAR(C(0, 0), 1e-4, 1e-12);  // the direction free: the segments alone fix nothing
   split.prior_information(5, 5) = 1e4;
-  ASSERT_TRUE(pair_covariance(split, Eigen::Matrix3d::Zero(), 100.0, 10.0, options, &C));
+  ASSERT_TRUE(pair_covariance(split, Spread::Zero(), 100.0, 10.0, options, &C));
   // The segments and the prior in series give w_x 1 / (1 / 1e4 + 1 / 1e4) = 5e3, the points 1e4
   // beside them.
   EXPECT_NEAR(C(0, 0), 1.0 / 1.5e4, 1e-9);
   // Twenty segments count as ten: their information halves.
-  ASSERT_TRUE(pair_covariance(split, Eigen::Matrix3d::Zero(), 100.0, 20.0, options, &C));
+  ASSERT_TRUE(pair_covariance(split, Spread::Zero(), 100.0, 20.0, options, &C));
   const double segments = 0.5e4, chain = 1.0 / (1.0 / segments + 1.0 / 1e4);
   EXPECT_NEAR(C(0, 0), 1.0 / (1e4 + chain), 1e-9);
 }
@@ -101,15 +103,15 @@ TEST(PairCovariance, BadInputIsNoCovariance) {
   Eigen::Matrix<double, 6, 6> C;
   InformationSplit split = diagonal_split(0);
   split.valid = false;
-  EXPECT_FALSE(pair_covariance(split, Eigen::Matrix3d::Zero(), 100, 0, options, &C));
+  EXPECT_FALSE(pair_covariance(split, Spread::Zero(), 100, 0, options, &C));
   EXPECT_TRUE(C.isZero());
   split = diagonal_split(0);
-  EXPECT_FALSE(pair_covariance(split, Eigen::Matrix3d::Constant(NAN), 100, 0, options, &C));
+  EXPECT_FALSE(pair_covariance(split, Spread::Constant(NAN), 100, 0, options, &C));
   split.points_covariance(1, 1) = -1.0;  // not a covariance
-  EXPECT_FALSE(pair_covariance(split, Eigen::Matrix3d::Zero(), 100, 0, options, &C));
+  EXPECT_FALSE(pair_covariance(split, Spread::Zero(), 100, 0, options, &C));
   split = diagonal_split(1);
   split.prior_information.resize(5, 5);  // sizes that disagree
-  EXPECT_FALSE(pair_covariance(split, Eigen::Matrix3d::Zero(), 100, 0, options, &C));
+  EXPECT_FALSE(pair_covariance(split, Spread::Zero(), 100, 0, options, &C));
 }
 
 double rotation_nees(const RelativePoseEstimate& est, const Eigen::Matrix3d& truth,

@@ -82,13 +82,13 @@ class LocalOptimizer {
 };
 
 // Keeps the hypotheses within `margin` of `best`, at most `cap` of the cheapest.
-void prune_near_best(double best, double margin, size_t cap, std::vector<RotationHypothesis>* kept) {
+void prune_near_best(double best, double margin, size_t cap, std::vector<PoseHypothesis>* kept) {
   kept->erase(std::remove_if(kept->begin(), kept->end(),
-                             [&](const RotationHypothesis& h) { return !(h.cost < best + margin); }),
+                             [&](const PoseHypothesis& h) { return !(h.cost < best + margin); }),
               kept->end());
   if (kept->size() <= cap) return;
   std::nth_element(kept->begin(), kept->begin() + cap, kept->end(),
-                   [](const RotationHypothesis& a, const RotationHypothesis& b) { return a.cost < b.cost; });
+                   [](const PoseHypothesis& a, const PoseHypothesis& b) { return a.cost < b.cost; });
   kept->resize(cap);
 }
 
@@ -196,7 +196,7 @@ HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,
       // what makes scoring cheap.
       const double cost = scorer.cost(pose, out.best_cost + (keep ? near_best_margin : 0.0));
       if (keep && cost < out.best_cost + near_best_margin) {
-        out.near_best.push_back({pose.R, cost});
+        out.near_best.push_back({pose.R, cost, pose.t});
         if (out.near_best.size() >= 2 * cap) prune_near_best(out.best_cost, near_best_margin, cap, &out.near_best);
       }
       if (cost < out.best_cost) {

@@ -24,7 +24,7 @@ struct HybridRansacOutcome {
   // The minimal-sample hypotheses whose cost came within `near_best_margin` of the best cost
   // (the final best's), at most `max_near_best` of the cheapest: the models the data could not
   // rule out (pair_covariance.h).
-  std::vector<RotationHypothesis> near_best;
+  std::vector<PoseHypothesis> near_best;
 };
 
 HybridRansacOutcome run_hybrid_ransac(const HybridProblem& problem,

@@ -25,18 +25,49 @@ Eigen::MatrixXd pseudo_inverse(const Eigen::MatrixXd& A, double relative = 1e-12
 
 }  // namespace
 
-Eigen::Matrix3d rotation_spread(const std::vector<RotationHypothesis>& hypotheses,
+Eigen::Matrix3d rotation_spread(const std::vector<PoseHypothesis>& hypotheses,
                                 const Eigen::Matrix3d& R, double best_cost, double temperature) {
   Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
   if (!(temperature > 0.0) || !std::isfinite(best_cost) || !all_finite(R)) return spread;
   double total = 1.0;  // R itself
-  for (const RotationHypothesis& h : hypotheses) {
+  for (const PoseHypothesis& h : hypotheses) {
     if (!all_finite(h.R) || !std::isfinite(h.cost)) continue;
     const double weight = std::exp(-std::max(0.0, h.cost - best_cost) / temperature);
     const Eigen::AngleAxisd apart(Eigen::Matrix3d(h.R * R.transpose()));
     const Eigen::Vector3d w = apart.angle() * apart.axis();
     if (!all_finite(w)) continue;
     spread += weight * w * w.transpose();
+    total += weight;
+  }
+  return spread / total;
+}
+
+Eigen::Matrix<double, 5, 5> pose_spread(const std::vector<PoseHypothesis>& hypotheses,
+                                        const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                                        const Eigen::Matrix<double, 3, 2>& B, double best_cost,
+                                        double temperature) {
+  Eigen::Matrix<double, 5, 5> spread = Eigen::Matrix<double, 5, 5>::Zero();
+  const double length = t.norm();
+  if (!(temperature > 0.0) || !std::isfinite(best_cost) || !all_finite(R) || !all_finite(B) ||
+      !(length > 0.0) || !std::isfinite(length))
+    return spread;
+  const Eigen::Vector3d u = t / length;
+  double total = 1.0;  // (R, t) itself
+  for (const PoseHypothesis& h : hypotheses) {
+    if (!all_finite(h.R) || !std::isfinite(h.cost) || !all_finite(h.t)) continue;
+    const double weight = std::exp(-std::max(0.0, h.cost - best_cost) / temperature);
+    const Eigen::AngleAxisd apart(Eigen::Matrix3d(h.R * R.transpose()));
+    Eigen::Matrix<double, 5, 1> z = Eigen::Matrix<double, 5, 1>::Zero();
+    z.head<3>() = apart.angle() * apart.axis();
+    if (h.t.norm() > 0.0) {
+      // The sphere's log map at u of the nearer sign of h.t: its angle along the tangent.
+      const Eigen::Vector3d v = (h.t.dot(u) < 0.0 ? -h.t : h.t).normalized();
+      const Eigen::Vector3d across = v - v.dot(u) * u;
+      const double sine = across.norm(), angle = std::atan2(sine, v.dot(u));
+      if (sine > 1e-15) z.tail<2>() = B.transpose() * across * (angle / sine);
+    }
+    if (!all_finite(z)) continue;
+    spread += weight * z * z.transpose();
     total += weight;
   }
   return spread / total;
@@ -49,18 +80,17 @@ double hypothesis_temperature(double matches, double independent, double sigma_p
   return 2.0 * ratio * ratio * std::max(1.0, matches / independent);
 }
 
-bool pair_covariance(const InformationSplit& split, const Eigen::Matrix3d& rotation_spread,
+bool pair_covariance(const InformationSplit& split, const Eigen::Matrix<double, 5, 5>& spread,
                      double point_matches, double segments, const PairCovarianceOptions& options,
                      Eigen::Matrix<double, 6, 6>* covariance) {
   covariance->setZero();
-  if (!split.valid || !all_finite(rotation_spread)) return false;
+  if (!split.valid || !all_finite(spread)) return false;
   const int n = static_cast<int>(split.segment_information.rows());
   if (n < 5 || split.prior_information.rows() != n) return false;
   const double g_points = std::max(1.0, point_matches / options.independent_points);
   const double g_segments = std::max(1.0, segments / options.independent_segments);
-  // The points' own covariance, widened by the competing rotations; as information.
-  Eigen::Matrix<double, 5, 5> points = g_points * split.points_covariance;
-  points.topLeftCorner<3, 3>() += rotation_spread;
+  // The points' own covariance, widened by the competing poses; as information.
+  Eigen::Matrix<double, 5, 5> points = g_points * split.points_covariance + spread;
   const Eigen::LLT<Eigen::Matrix<double, 5, 5>> llt(0.5 * (points + points.transpose()));
   if (llt.info() != Eigen::Success) return false;
   // Segments, VPs and priors, their VP directions marginalised (Schur complement).

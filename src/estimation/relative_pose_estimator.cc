@@ -428,6 +428,8 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
     refine_final(problem, scorer, options, matches, outcome, &est, &split);
     est.refine_ms = ms_since(refine_start);
   }
+  // The split's tangent is that of the refined t, before its sign is chosen.
+  const Eigen::Vector3d refined_t = est.pose.t;
   // The Sampson error cannot tell t from -t, and the minimal sample that fixed the sign was
   // tiny: the inliers vote on it (depths in front of both cameras).
   orient_by_inliers(problem, scorer, &est.pose);
@@ -436,7 +438,12 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
   if (honest.enabled && est.covariance_valid) {
     const double point_matches = est.num_point_inliers + est.num_junction_inliers;
     est.rotation_spread = competing_spread(outcome, est.pose.R, point_matches, est, options);
-    if (!pair_covariance(split, est.rotation_spread, point_matches, est.num_line_inliers, honest,
+    const Eigen::Matrix<double, 5, 5> spread = pose_spread(
+        outcome.near_best, est.pose.R, refined_t, split.to_pose.bottomRightCorner<3, 2>(),
+        outcome.best_cost,
+        hypothesis_temperature(point_matches, honest.ambiguity_independent_points,
+                               est.scales.point_px, options.ransac.point_threshold_px));
+    if (!pair_covariance(split, spread, point_matches, est.num_line_inliers, honest,
                          &est.covariance)) {
       // The points alone do not fix the pose (too few, or VPs carry it): the refinement's
       // covariance, its segments counted as independent_segments, and the spread.
@@ -444,6 +451,8 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
           std::max(1.0, est.num_line_inliers / honest.independent_segments) * est.hessian_covariance;
       est.covariance.topLeftCorner<3, 3>() += est.rotation_spread;
     }
+    const double shared = honest.shared_error_px / camera2.mean_focal();
+    est.covariance.topLeftCorner<3, 3>() += shared * shared * Eigen::Matrix3d::Identity();
   }
   return finish(EstimationStatus::kOk);
 }

@@ -412,6 +412,10 @@ RotationOnlyEstimate estimate_rotation_only(const PinholeCamera& camera1,
   if (eigen.info() == Eigen::Success && smallest > 1e-9 * largest && smallest > 0.0) {
     est.covariance = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
                      eigen.eigenvectors().transpose();
+    if (honest.enabled && np > 0) {
+      const double shared = honest.shared_error_px / camera2.mean_focal();
+      est.covariance += shared * shared * Eigen::Matrix3d::Identity();
+    }
     est.covariance_valid = all_finite(est.covariance);
   }
   est.ok = est.covariance_valid &&

@@ -7,6 +7,7 @@
 #include <map>
 #include <vector>
 
+#include "hybrid_vo/estimation/stereo_motion.h"
 #include "hybrid_vo/frontend/gray_image.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 
@@ -38,7 +39,17 @@ struct VisualOdometry::Frame {
   ImageFeatures features;                     // segments (and descriptor points)
   std::vector<int64_t> line_ids;              // with track_lines: the track of each segment
   std::vector<int64_t> point_ids;             // per point match: its id
-  double parallax = -1.0;  // median image motion of the point matches; -1 below 5 matches
+  // The median transfer error of the point matches under the rotation that best explains them
+  // (the parallax after the rotation), or their median motion where no rotation was found;
+  // -1 below 5 matches.
+  double parallax = -1.0;
+  // That rotation, from the points alone (match_points), then from every modality for a pair
+  // answered with its rotation alone (estimate_rotation).
+  RotationOnlyEstimate rotation;
+  bool rotation_only = false;  // the pair is answered with its rotation alone
+  bool baseline = true;        // its parallax after the rotation makes a baseline
+  // Stereo, without a baseline or with a rotation alone: the motion from the stereo points.
+  StereoMotionEstimate stereo_motion;
 
   // Stereo: the pair's pyramids, the frame's stereo points, the scale's observations.
   StereoPair pair;

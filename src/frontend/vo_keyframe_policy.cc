@@ -1,7 +1,11 @@
 // VisualOdometry's keyframe policy: every frame is paired with the last keyframe. A frame becomes
-// the keyframe when its pose is found, and when a new chain starts at it (the first frame, or too
-// few matches to pair it); it is left out, the keyframe staying, when it moved too little for an
-// epipolar geometry (min_parallax_px) or no pose was found. Also what a keyframe keeps.
+// the keyframe when its full pose is found over a baseline, and when a new chain starts at it (the
+// first frame, or too few matches to pair it). Where it moved too little off its rotation for a
+// baseline (min_parallax_px: the parallax after the rotation), or its points' noise explains what
+// the rotation leaves (model selection: then it is answered with its rotation alone), the
+// keyframe stays, so that the baseline grows, until the keyframe's points are leaving the view
+// (rotation_keyframe_overlap). Without rotation-only pairs such frames are left out, as any
+// frame whose pose is not found. Also what a keyframe keeps.
 #include <string>
 
 #include "vo_frame.h"
@@ -12,7 +16,7 @@ bool VisualOdometry::low_parallax(const Frame& f) const {
   return f.parallax >= 0.0 && f.parallax < options_.min_parallax_px;
 }
 
-VisualOdometry::Pairing VisualOdometry::decide_keyframe(Frame& f) const {
+VisualOdometry::Pairing VisualOdometry::decide_keyframe(Frame& f) {
   VisualOdometryResult& r = f.result;
   if (!keyframe_.valid) {
     r.status = f.was_reset ? VoStatus::kReset : VoStatus::kFirstFrame;
@@ -28,12 +32,19 @@ VisualOdometry::Pairing VisualOdometry::decide_keyframe(Frame& f) const {
                 std::to_string(r.num_line_matches) + " segments): re-initialised";
     return Pairing::kNewKeyframe;
   }
+  if (keyframe_.paired_points < 0) keyframe_.paired_points = r.num_point_matches;
   if (low_parallax(f)) {
     r.status = VoStatus::kLowParallax;
-    r.message = "median motion " + std::to_string(f.parallax) + " px";
-    return Pairing::kSkip;
+    r.message = "parallax after the rotation " + std::to_string(f.parallax) + " px";
+    if (!options_.rotation_only_pairs) return Pairing::kSkip;
+    return Pairing::kEstimateKeepKeyframe;
   }
   return Pairing::kEstimate;
+}
+
+bool VisualOdometry::keeps_keyframe(const Frame& f) const {
+  return f.result.num_point_matches >=
+         options_.rotation_keyframe_overlap * std::max(0, keyframe_.paired_points);
 }
 
 VisualOdometryResult VisualOdometry::keep_as_keyframe(Frame& f) {
@@ -81,6 +92,9 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
   keyframe_.R_wc_covariance = orientation_.covariance();
   keyframe_.centre = centre_;
   keyframe_.pose_covariance = pose_covariance_.covariance();
+  keyframe_.paired_points = -1;
+  last_answer_stamp_ = input.stamp;
+  last_answer_R_wc_ = keyframe_.R_wc;
   if (input.external.has_lines)
     for (size_t i = 0; i < input.external.lines.size() && i < input.external.line_ids.size(); ++i)
       keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];

@@ -48,6 +48,7 @@ OrientationFilterOptions filter_options(const VisualOdometryOptions& options) {
 VoOrientation::VoOrientation(const VisualOdometryOptions& options)
     : use_map_(options.use_direction_map),
       rotation_calibration_sigma_(options.rotation_calibration_sigma),
+      full_pair_turn_fraction_(options.full_pair_turn_fraction),
       seed_sigma_px_(options.estimator.vp_detection.inlier_threshold_px / 3.0),
       seed_sigma_deg_(options.estimator.ransac.vp_threshold_deg / 3.0),
       filter_(filter_options(options)) {}
@@ -108,6 +109,7 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
                                                                Eigen::Matrix3d::Identity());
   rotation.segment_matches = static_cast<int>(m.lines.size());
   rotation.vp_inliers = est.num_vp_inliers;
+  rotation.rotation_only = pair.rotation_only;
   if (pair.dt > 0.0) {
     const Eigen::Vector3d w = angular_velocity_ * pair.dt;
     rotation.has_last_motion = true;
@@ -149,31 +151,53 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
   const double blank = std::hypot(o.estimate.blank_wall_sigma_rad, unknown);
   const Eigen::AngleAxisd turned(o.pose.R);
   const Eigen::Vector3d w = turned.angle() * turned.axis();
-  const double c = rotation_calibration_sigma_;
-  o.motion_rotation_extra = (blank * blank + c * c * w.squaredNorm()) * Eigen::Matrix3d::Identity();
+  const double c = rotation_calibration_sigma_,
+               k = pair.rotation_only ? 0.0 : full_pair_turn_fraction_;
+  o.motion_rotation_extra =
+      (blank * blank + (c * c + k * k) * w.squaredNorm()) * Eigen::Matrix3d::Identity();
   return o;
 }
 
-void VoOrientation::advance(const Oriented& oriented, double dt,
-                            const Eigen::Matrix3d& motion_rotation_covariance) {
-  // A coasted pair keeps the last rate: its own rotation is what could not be trusted.
-  if (dt > 0.0 && oriented.estimate.source != OrientationSource::kCoasted) {
-    const Eigen::AngleAxisd turned(oriented.scale_pose.R);
-    angular_velocity_ = turned.angle() * turned.axis() / dt;
-  }
+void VoOrientation::accumulate(const Oriented& oriented,
+                               const Eigen::Matrix3d& motion_rotation_covariance,
+                               double* sigma_sum, double* variance_sum) const {
+  *sigma_sum = sigma_sum_;
+  *variance_sum = variance_sum_;
   const double variance = std::max(0.0, motion_rotation_covariance.trace() / 3.0);
   if (std::isfinite(variance)) {
-    sigma_sum_ += std::sqrt(variance);
-    variance_sum_ += variance;
+    *sigma_sum += std::sqrt(variance);
+    *variance_sum += variance;
   }
   // The map's correction shrank the filter's uncertainty by a share: the excess shrinks alike
   // (sigma_sum^2 - variance_sum scales with it).
   const double before = oriented.estimate.predicted_covariance.trace();
   const double share = before > 0.0 ? oriented.covariance.trace() / before : 1.0;
   if (std::isfinite(share) && share < 1.0) {
-    sigma_sum_ *= std::sqrt(std::max(0.0, share));
-    variance_sum_ *= std::max(0.0, share);
+    *sigma_sum *= std::sqrt(std::max(0.0, share));
+    *variance_sum *= std::max(0.0, share);
   }
+}
+
+Eigen::Matrix3d VoOrientation::reported_covariance(
+    const Oriented& oriented, const Eigen::Matrix3d& motion_rotation_covariance) const {
+  double sigma_sum = 0.0, variance_sum = 0.0;
+  accumulate(oriented, motion_rotation_covariance, &sigma_sum, &variance_sum);
+  const double bound = std::max(0.0, sigma_sum * sigma_sum - variance_sum);
+  return oriented.covariance + bound * Eigen::Matrix3d::Identity();
+}
+
+void VoOrientation::set_rate(const Eigen::Matrix3d& R, double dt) {
+  if (!(dt > 0.0) || !all_finite(R)) return;
+  const Eigen::AngleAxisd turned(R);
+  angular_velocity_ = turned.angle() * turned.axis() / dt;
+}
+
+void VoOrientation::advance(const Oriented& oriented, double dt,
+                            const Eigen::Matrix3d& motion_rotation_covariance) {
+  // A coasted pair keeps the last rate: its own rotation is what could not be trusted.
+  if (oriented.estimate.source != OrientationSource::kCoasted)
+    set_rate(oriented.scale_pose.R, dt);
+  accumulate(oriented, motion_rotation_covariance, &sigma_sum_, &variance_sum_);
   R_wc_ = oriented.R_wc;
   covariance_ = oriented.covariance;
   // Without the map too: the filter carries the rotation scale's share of the orientation.

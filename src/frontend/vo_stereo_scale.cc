@@ -180,10 +180,58 @@ void VisualOdometry::add_current_disparities(Frame& f) const {
   }
 }
 
+void VisualOdometry::measure_stereo_motion(Frame& f) {
+  if (!f.stereo) return;
+  add_current_disparities(f);
+  const auto start = std::chrono::steady_clock::now();
+  RelativePoseEstimate& est = f.result.estimate.estimate;
+  const StereoRig rig{f.input.camera.pinhole.fx, f.input.camera.pinhole.fy, f.input.baseline_m};
+  StereoScaleOptions options = options_.stereo_scale;
+  options.disparity_offset_px = f.result.disparity_offset_px = offset_filter_.offset();
+  f.stereo_motion = estimate_stereo_motion(est.pose.R, rig, f.scale_observations, options,
+                                           pair_options().covariance.independent_points);
+  if (f.stereo_motion.ok) {
+    est.pose.R = f.stereo_motion.R;
+    est.covariance.topLeftCorner<3, 3>() = f.stereo_motion.covariance.topLeftCorner<3, 3>();
+  }
+  f.result.stages.scale_ms += ms_since(start);
+}
+
+void VisualOdometry::fit_translation_without_baseline(Frame& f) {
+  // No baseline: the translation is zero, within a pair's length per axis (mono_scale), unless
+  // the keyframe's stereo points measured it (at rest: zero within their noise; a camera turning
+  // about a point behind it: the lever arm's arc).
+  VisualOdometryResult& r = f.result;
+  const RelativePoseEstimate& est = r.estimate.estimate;
+  r.motion = RelativePose(f.oriented.pose.R, Eigen::Vector3d::Zero());
+  r.motion_covariance.setZero();
+  r.motion_covariance.topLeftCorner<3, 3>() = est.covariance.topLeftCorner<3, 3>();
+  r.motion_covariance.bottomRightCorner<3, 3>() =
+      options_.mono_scale * options_.mono_scale * Eigen::Matrix3d::Identity();
+  r.motion_covariance_valid = est.covariance_valid;
+  if (f.stereo) {
+    r.stereo_scale_attempted = true;
+    r.scale_observations = std::move(f.scale_observations);
+    const StereoMotionEstimate& m = f.stereo_motion;
+    r.stereo_scale.near_points = m.points;
+    r.stereo_scale.inliers = m.inliers;
+    r.stereo_scale.status = m.ok ? StereoScaleStatus::kOk : StereoScaleStatus::kTooFewNearPoints;
+    if (m.ok) {
+      r.motion.t = m.t;
+      r.motion_covariance = m.covariance;
+      r.stereo_scale.scale = m.t.norm();
+      r.stereo_scale.sigma = std::sqrt(std::max(0.0, m.covariance.bottomRightCorner<3, 3>().trace()));
+      r.scale_known = true;
+    }
+  }
+  r.motion_covariance.topLeftCorner<3, 3>() += f.oriented.motion_rotation_extra;
+}
+
 void VisualOdometry::fit_scale(Frame& f) {
   // The keyframe's stereo points seen again, with this frame's disparities, fitted in disparity
   // and image space (estimate_stereo_scale); without a usable fit, the configured length and
   // scale_known false.
+  if (f.rotation_only || !f.baseline) return fit_translation_without_baseline(f);
   VisualOdometryResult& r = f.result;
   const RelativePoseEstimate& est = r.estimate.estimate;
   const RelativePose& pose = f.oriented.pose;

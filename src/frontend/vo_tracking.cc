@@ -86,8 +86,21 @@ void VisualOdometry::match_points(Frame& f) const {
       f.point_ids.push_back(id);
     }
   }
-  // Whether the frame moved enough to be estimated (low_parallax).
-  if (matches.size() >= 5) f.parallax = median_motion_px(matches);
+  // Whether the frame moved enough to be estimated (low_parallax): the parallax the rotation that
+  // best explains the points leaves (a pan's motion is no baseline), else their motion.
+  if (matches.size() < 5) return;
+  f.parallax = median_motion_px(matches);
+  TwoViewMatches points;
+  points.points = matches;
+  if (!(f.input.external.has_points && f.input.external.points_undistorted &&
+        keyframe_.points_undistorted))
+    undistort_matches(keyframe_.camera, f.input.camera, &points);
+  RotationOnlyOptions options = options_.rotation_only;
+  options.use_lines = options.use_vps = false;
+  f.rotation = estimate_rotation_only(keyframe_.camera.pinhole, f.input.camera.pinhole, points,
+                                      options, options_.estimator.covariance);
+  if (f.rotation.ok && f.rotation.parallax_px >= 0.0) f.parallax = f.rotation.parallax_px;
+  f.result.parallax_px = f.parallax;
 }
 
 void VisualOdometry::start_redetection(Frame& f) {

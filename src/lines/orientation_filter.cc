@@ -66,7 +66,8 @@ OrientationEstimate OrientationFilter::predict(const Eigen::Matrix3d& R1,
   e.covariance = P1;
   if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
   // A blank wall is the pair's, map or not.
-  e.blank_wall = pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
+  e.blank_wall = !pair.rotation_only &&
+                 pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
   e.blank_wall_sigma_rad = e.blank_wall ? blank_wall_sigma(pair.R) : 0.0;
   e.location.joint =
       predict(R1, P1, pair, e.blank_wall_sigma_rad, &e.R_world_from_camera, &e.covariance);
@@ -83,7 +84,8 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   e.R_world_from_camera = R1;  // a non-finite input: nothing of the pair is taken
   e.covariance = P1;
   if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
-  e.blank_wall = pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
+  e.blank_wall = !pair.rotation_only &&
+                 pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
   const double extra = e.blank_wall ? blank_wall_sigma(pair.R) : 0.0;
   e.blank_wall_sigma_rad = extra;
   PairRotation coasted;
@@ -126,6 +128,9 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
 bool OrientationFilter::judge(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
                               const PairRotation& pair, double extra_sigma_rad,
                               OrientationEstimate* e) const {
+  // A rotation-only pair's points pin its rotation (no plane's second motion, no translation to
+  // trade it for): nothing for the map to overrule.
+  if (pair.rotation_only) return false;
   if (pair.vps.size() < 2 || pair.keyframe_vps.size() != pair.vps.size()) return false;
   // Only a pair whose pose refuses a VP that the keyframe saw as a direction of the map.
   const MapLocation before = map_.locate(R1, P1, pair.keyframe_vps);

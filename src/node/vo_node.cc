@@ -244,8 +244,7 @@ void VoNode::record_result(const Frame& frame, const VisualOdometryResult& resul
     ++frames_;
     last_processed_ = frame.stamp;
     last_result_ = result;
-    if (result.status == VoStatus::kOk || result.status == VoStatus::kFirstFrame ||
-        result.status == VoStatus::kLowParallax) {
+    if (answered(result.status) || result.status == VoStatus::kLowParallax) {
       // The fault that restarted the chain stays in the summary until a frame pairs again.
       if (!lost) last_problem_.clear();
     } else {
@@ -264,7 +263,8 @@ void VoNode::record_result(const Frame& frame, const VisualOdometryResult& resul
       if (est.vp_prior_used[k]) ++vp_priors_used_;
       else if (std::isfinite(est.vp_prior_chi2[k])) ++vp_priors_rejected_;
     }
-    if (result.status == VoStatus::kOk) {
+    rotation_only_frames_ += result.status == VoStatus::kRotationOnly;
+    if (result.status == VoStatus::kOk || result.status == VoStatus::kRotationOnly) {
       blank_wall_frames_ += result.orientation.blank_wall;
       pairs_overruled_ += result.orientation.source == OrientationSource::kPairRejected;
     }

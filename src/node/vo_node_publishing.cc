@@ -20,6 +20,7 @@ namespace {
 uint8_t status_code(const VisualOdometryResult& r) {
   switch (r.status) {
     case VoStatus::kOk:
+    case VoStatus::kRotationOnly:
       return MotionEstimate::STATUS_OK;
     case VoStatus::kInvalidInput:
       return MotionEstimate::STATUS_INVALID_INPUT;
@@ -101,9 +102,7 @@ void VoNode::publish(const Frame& frame, const VisualOdometryInput& input,
                      const VisualOdometryResult& result, bool lost) {
   camera_frame_ = frame.frame_id;
   publish_relative_pose(frame, result, lost);
-  if (result.status == VoStatus::kOk || result.status == VoStatus::kFirstFrame ||
-      result.status == VoStatus::kReset)
-    publish_pose(frame.stamp, frame.frame_id, result, lost);
+  if (answered(result.status)) publish_pose(frame.stamp, frame.frame_id, result, lost);
   publish_vanishing_points(frame.stamp, result);
   if (params_.publish_markers && markers_pub_.getNumSubscribers() > 0)
     publish_markers(frame.stamp, input, result);
@@ -122,7 +121,9 @@ void VoNode::publish_relative_pose(const Frame& frame, const VisualOdometryResul
   const std::string& message = lost ? monitor_.description() : result.message;
   rel.status_text =
       std::string(to_string(result.status)) + (message.empty() ? "" : ": " + message);
-  const bool moved = result.status == VoStatus::kOk;
+  const bool moved = result.status == VoStatus::kOk || result.status == VoStatus::kRotationOnly;
+  rel.rotation_only = result.status == VoStatus::kRotationOnly;
+  rel.parallax_px = result.parallax_px;
   rel.transform = moved ? to_transform(result.motion.R, result.motion.t)
                         : to_transform(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
   rel.scale_known = moved && result.scale_known;
@@ -198,7 +199,7 @@ void VoNode::publish_odometry(const geometry_msgs::TransformStamped& tf,
                            : result.pose_covariance);
   PairTwist twist;
   const bool twist_known =
-      result.status == VoStatus::kOk &&
+      (result.status == VoStatus::kOk || result.status == VoStatus::kRotationOnly) &&
       pair_twist(result.motion.R, result.motion.t, result.motion_covariance,
                  tf.header.stamp.toSec() - result.reference_stamp, R_bc, t_bc, &twist);
   odometry.twist.twist.linear = to_vector(twist.linear);

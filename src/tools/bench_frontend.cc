@@ -44,7 +44,8 @@ void usage(const char* program) {
                " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
-               " [--max-features N] [--redetect-alternate] [--verbose]\n"
+               " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
+               " [--no-rotation-only] [--rotation-keyframe-overlap F] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
@@ -74,7 +75,12 @@ void usage(const char* program) {
                "  --work-level L: its min_work_level, a fixed level 0-4 (cpu_budget.h);\n"
                "  --max-features N: the point budget (default 1500, as config/kitti.yaml);\n"
                "  --redetect-alternate: KLT re-detection in half the cells per frame, taking\n"
-               "  turns (klt_redetect_alternate: true).\n";
+               "  turns (klt_redetect_alternate: true).\n"
+               "  --rotation-calibration-sigma S: the node's rotation_calibration_sigma (how far\n"
+               "  every rotation may be off as a share of its angle; config/kitti.yaml: 0.01).\n"
+               "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
+               "  (rotation_only_pairs: false); --rotation-keyframe-overlap F: the node's\n"
+               "  rotation_keyframe_overlap.\n";
 }
 
 // The median of each coordinate.
@@ -224,6 +230,12 @@ int run(int argc, char** argv) {
       o.stereo.predicted_pyramid_levels = std::atoi(argv[++i]);
     else if (a == "--stereo-iterations" && i + 1 < argc)
       o.stereo.max_iterations = std::atoi(argv[++i]);
+    else if (a == "--rotation-calibration-sigma" && i + 1 < argc)
+      o.rotation_calibration_sigma = std::atof(argv[++i]);
+    else if (a == "--no-rotation-only")
+      o.rotation_only_pairs = false;
+    else if (a == "--rotation-keyframe-overlap" && i + 1 < argc)
+      o.rotation_keyframe_overlap = std::atof(argv[++i]);
     else {
       usage(argv[0]);
       return 2;
@@ -313,7 +325,9 @@ int run(int argc, char** argv) {
   std::vector<double> total, frontend, estimator, points, redetect, lines, matching, vps, ransac,
       stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
-  int ok = 0;
+  int ok = 0, rotation_only = 0, answered_frames = 0;
+  std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
+  double farthest = 0.0;             // of the position from the first frame's
   // How the map of world directions served the estimated frames (as eval_trajectory prints it).
   int held = 0, reacquired = 0, rejected = 0, blank = 0, coasted = 0, overruled = 0;
   double lines_sum = 0.0, inliers_sum = 0.0;
@@ -343,17 +357,18 @@ int run(int argc, char** argv) {
       truth.push_back(g);
       const int reference = frame_of(r.reference_stamp);
       // A frame skipped for too little parallax is no pair, as hybrid_vo_eval_trajectory skips
-      // the node's STATUS_SKIPPED; a failure to estimate counts as an error of 180 degrees.
+      // the node's STATUS_SKIPPED; a failure to estimate counts as an error of 180 degrees. A
+      // rotation-only pair has a rotation to compare, and no translation direction: it is left
+      // out of the pose AUC.
+      const bool full = r.status == VoStatus::kOk, turned = r.status == VoStatus::kRotationOnly;
       if (i > 0 && reference >= 0 && reference < i && r.status != VoStatus::kLowParallax) {
         double error = 180.0;
-        if (r.status == VoStatus::kOk) {
+        if (full || turned) {
           const datasets::KittiPose& a = gt[reference];
           const datasets::KittiPose& b = gt[i];
           const RelativePose truth_pose{b.R_wc.transpose() * a.R_wc,
                                         b.R_wc.transpose() * (a.c_w - b.c_w)};
           pair_rot_deg.push_back(rotation_error(r.motion.R, truth_pose.R) * 180.0 / M_PI);
-          pair_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
-          error = std::max(pair_rot_deg.back(), pair_dir_deg.back());
           // The motion and covariance the node publishes on ~relative_pose.
           const Eigen::Matrix<double, 6, 6>& C = r.motion_covariance;
           const bool valid = r.motion_covariance_valid;
@@ -361,9 +376,18 @@ int run(int argc, char** argv) {
                                                                     C.topLeftCorner<3, 3>(),
                                                                     truth_rotation_sigma)
                                         : NAN);
-          pair_dir_nees.push_back(valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
-                                                                     C.bottomRightCorner<3, 3>(),
-                                                                     truth_direction_sigma)
+          if (full) {
+            pair_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
+            error = std::max(pair_rot_deg.back(), pair_dir_deg.back());
+            pair_dir_nees.push_back(
+                valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
+                                                   C.bottomRightCorner<3, 3>(),
+                                                   truth_direction_sigma)
+                      : NAN);
+          }
+          if (r.scale_known)
+            pair_t_nees.push_back(valid ? evaluation::translation_nees(
+                                              r.motion.t, truth_pose.t, C.bottomRightCorner<3, 3>())
                                         : NAN);
           // The orientation's covariance as the node reports it: the pose covariance's rotation
           // block (VoOrientation::reported_covariance).
@@ -372,7 +396,15 @@ int run(int argc, char** argv) {
               Eigen::Matrix3d(r.pose_covariance.bottomRightCorner<3, 3>()),
               truth_orientation_sigma));
         }
-        pose_errors.push_back(error);
+        if (!turned) pose_errors.push_back(error);
+        if (verbose && (full || turned))
+          std::printf("pair %d: reference %d, %s, turned %.3f deg, parallax %.2f px, rotation "
+                      "error %.4f deg, NEES %.2f%s; %s\n",
+                      i, reference, to_string(r.status),
+                      Eigen::AngleAxisd(r.motion.R).angle() * 180.0 / M_PI, r.parallax_px,
+                      pair_rot_deg.back(),
+                      pair_rot_nees.back(), r.became_keyframe ? ", keyframe" : "",
+                      r.message.c_str());
       }
     }
     if (verbose) {
@@ -480,7 +512,10 @@ int run(int argc, char** argv) {
     vps.push_back(r.stages.vps_ms);
     ransac.push_back(r.stages.ransac_ms);
     stereo_ms.push_back(r.stages.stereo_ms);
-    if (r.status != VoStatus::kOk) continue;
+    answered_frames += answered(r.status);
+    farthest = std::max(farthest, (r.centre - odometry.front().c).norm());
+    rotation_only += r.status == VoStatus::kRotationOnly;
+    if (r.status != VoStatus::kOk && r.status != VoStatus::kRotationOnly) continue;
     ++ok;
     const OrientationSource source = r.orientation.source;
     held += source == OrientationSource::kMap || source == OrientationSource::kReacquired;
@@ -505,6 +540,13 @@ int run(int argc, char** argv) {
   std::printf("frames %d, estimated %d (%s, %s, %s)\n", frames, ok,
               o.concurrent ? "concurrent" : "sequential", o.track_lines ? "line tracking" : "LBD",
               o.klt.predict_motion ? "KLT prediction" : "KLT plain");
+  // An odometry for a robot answers every frame: rotation-only ones too (the camera at rest or
+  // turning in place), and its position stays where the data hold it.
+  std::printf("# answers: %d of %d frames after the first have a pose (%.1f %%), %d of them "
+              "rotation-only; the position at most %.4f %s from the first frame's\n",
+              answered_frames, frames - 1,
+              frames > 1 ? 100.0 * answered_frames / (frames - 1) : 0.0, rotation_only, farthest,
+              stereo ? "m" : "per-pair units");
   std::printf("median ms: total %.1f, front end %.1f, estimator %.1f; points %.1f, "
               "re-detection %.1f, lines %.1f, "
               "line matching %.1f, VPs %.1f, RANSAC %.1f; CPU per frame %.1f\n",
@@ -538,7 +580,7 @@ int run(int argc, char** argv) {
               "%d held by the map, %d re-acquisitions, %d corrections rejected, %d blank walls "
               "(%d coasted), %d pairs overruled\n",
               confirmed, ok, held, reacquired, rejected, blank, coasted, overruled);
-  if (!pose_errors.empty()) {
+  if (!pose_errors.empty() || !pair_rot_deg.empty()) {
     const evaluation::TrajectoryErrors te =
         evaluation::compare_trajectories(estimate, truth, !stereo, 0.01);
     std::printf("accuracy: pairs %zu, AUC@5/10/20 %.2f / %.2f / %.2f, drift %.2f %% and %.3f "
@@ -564,6 +606,8 @@ int run(int argc, char** argv) {
                 "estimated pairs");
     consistency("orientation against the first frame", truth_orientation_sigma, orientation_nees,
                 3, "estimated frames");
+    if (stereo)
+      consistency("metric translation per pair", 0.0, pair_t_nees, 3, "pairs with a scale");
   }
   if (direct_gap > 0)
     print_direct_check(images, input.camera, odometry, truth, direct_gap,

@@ -347,6 +347,10 @@ int main(int argc, char** argv) {
   std::vector<double> scale_ratios;
   // NEES of the estimated pairs' rotation and translation direction; NaN without a covariance.
   std::vector<double> pair_rot_nees, pair_dir_nees;
+  // Stereo: the metric translation's NEES (3 dof). Rotation-only pairs: their rotation is
+  // compared, they have no direction and stay out of the pose AUC.
+  std::vector<double> pair_t_nees;
+  int rotation_only = 0;
   std::printf("pair,stamp_ref,stamp,status,rot_err_deg,dir_err_deg,scale_ratio\n");
   if (!run.motions.empty()) {
     for (const hybrid_vo::MotionEstimate& m : run.motions) {
@@ -367,11 +371,20 @@ int main(int argc, char** argv) {
         const Eigen::Matrix3d R_gt = b.R.transpose() * a.R;
         const Eigen::Vector3d t_gt = b.R.transpose() * (a.c - b.c);
         rot = hybrid_vo::rotation_error(R, R_gt) * kDeg;
-        dir = hybrid_vo::translation_error(t, t_gt) * kDeg;
         pair_rot.push_back(rot);
-        pair_dir.push_back(dir);
         pair_rot_nees.push_back(evaluation::rotation_nees(
             R, R_gt, evaluation::covariance_block(m.covariance.data(), 0), truth_rotation_sigma));
+        if (m.scale_known)
+          pair_t_nees.push_back(evaluation::translation_nees(
+              t, t_gt, evaluation::covariance_block(m.covariance.data(), 3)));
+        if (m.rotation_only) {
+          ++rotation_only;
+          std::printf("r,%.6f,%.6f,%d,%.4f,,\n", m.reference_stamp.toSec(),
+                      m.header.stamp.toSec(), m.status, rot);
+          continue;
+        }
+        dir = hybrid_vo::translation_error(t, t_gt) * kDeg;
+        pair_dir.push_back(dir);
         pair_dir_nees.push_back(evaluation::direction_nees(
             t, t_gt, evaluation::covariance_block(m.covariance.data(), 3), truth_direction_sigma));
         if (m.scale_known && t_gt.norm() > 1e-9) {
@@ -428,6 +441,15 @@ int main(int argc, char** argv) {
               "drift %.2f %% and %.3f deg/100 m over %d segments\n",
               failures, skipped, te.pairs + 1, with_scale ? "aligned" : "metric", te.scale,
               te.drift_trans_percent, te.drift_rot_deg_per_100m, te.drift_segments);
+  if (!run.motions.empty()) {
+    // An odometry for a robot answers every frame, at rest and turning in place too.
+    double farthest = 0.0;
+    for (const OdometrySample& o : run.odometry)
+      farthest = std::max(farthest, (o.camera.c - run.odometry.front().camera.c).norm());
+    std::printf("# answers: %zu odometry messages for %zu frames, %d rotation-only pairs; the "
+                "position at most %.4f from the first\n",
+                run.odometry.size(), run.motions.size(), rotation_only, farthest);
+  }
   if (!scale_ratios.empty())
     std::printf("# scale ratio (estimated / true translation length): median %.4f (p10 %.4f, "
                 "p90 %.4f) over %zu metric pairs\n",
@@ -438,6 +460,9 @@ int main(int argc, char** argv) {
   if (!bag.empty()) {
     rot_nees = evaluation::summarize_nees(pair_rot_nees, 3);
     print_consistency("rotation per pair", truth_rotation_sigma, rot_nees, "estimated pairs", "");
+    if (!pair_t_nees.empty())
+      print_consistency("metric translation per pair", 0.0, evaluation::summarize_nees(pair_t_nees, 3),
+                        "pairs with a scale", "");
     print_consistency("translation direction per pair", truth_direction_sigma,
                       evaluation::summarize_nees(pair_dir_nees, 2), "estimated pairs", "");
     orient_nees = orientation_consistency(run.odometry, gt, tolerance, truth_orientation_sigma);

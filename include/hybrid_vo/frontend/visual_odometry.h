@@ -15,6 +15,7 @@
 #include "hybrid_vo/frontend/klt_tracker.h"
 #include "hybrid_vo/frontend/line_tracker.h"
 #include "hybrid_vo/frontend/stage_timings.h"
+#include "hybrid_vo/estimation/rotation_only.h"
 #include "hybrid_vo/estimation/stereo_scale.h"
 #include "hybrid_vo/frontend/stereo.h"
 #include "hybrid_vo/frontend/vo_orientation.h"
@@ -46,9 +47,23 @@ struct VisualOdometryOptions {
   // estimator. The results do not depend on it.
   bool concurrent = true;
   TwoViewOptions estimator;   // preset "hybrid", VPs detected jointly from the segments
-  // Frames whose median point motion to the keyframe is below this are not estimated: the
-  // epipolar geometry of a tiny baseline is noise. The keyframe stays.
+  // Frames whose points move less than this off the rotation that best explains them (median
+  // transfer error to the keyframe, the parallax after the rotation: a pan is no baseline, and a
+  // slow one is not standing still) are no baseline: the keyframe stays, so that the baseline
+  // grows, until fewer than rotation_keyframe_overlap of the keyframe's point matches remain.
+  // With rotation_only_pairs they are answered all the same (else left out).
   double min_parallax_px = 2.0;
+  double rotation_keyframe_overlap = 0.7;
+  // Rotation-only pairs: where the points' own noise explains what the rotation leaves of their
+  // motion (model_selection, motion_model_selection.h), the frame's rotation against the keyframe
+  // is published with an honest covariance; else the full motion's. Without a baseline (or with
+  // a rotation alone) the translation is not the epipolar geometry's: zero in mono, within
+  // mono_scale (only a baseline moves a mono position: a pan's tracks drift enough for the full
+  // model to win now and then, and its direction is noise); in stereo the keyframe's stereo
+  // points give the rotation and the metric translation together.
+  bool rotation_only_pairs = true;
+  bool model_selection = true;
+  RotationOnlyOptions rotation_only;
   int min_point_matches = 8;  // below this and without enough segments the pair is hopeless
   int min_line_matches = 12;
   double mono_scale = 1.0;    // length given to a unit translation without stereo
@@ -75,10 +90,19 @@ struct VisualOdometryOptions {
   // How far every estimated rotation may be off as a whole, in its angle and in its axis (a
   // fraction: a focal length, a camera's mounting, or a ground truth's own): the orientation's
   // reported uncertainty grows by it times the angle turned, per axis
-  // (VoOrientation::reported_covariance). KITTI's excerpt turns 98 degrees and ends 1.0 degree
-  // off its ground truth: against every two-view estimate the truth turns 0.7 % more about axes
-  // tilted by 0.4 degrees (hybrid_vo_bench_frontend --direct-gap).
-  double rotation_calibration_sigma = 0.01;
+  // (VoOrientation::reported_covariance). 0: the camera_info is taken as exact (a pan in place
+  // over a photograph, whose pairs are 0.001 degrees off, would otherwise claim ten times that
+  // per degree turned). A full pair's own share of its angle is the estimator's
+  // (PairCovarianceOptions::turn_fraction): KITTI's truth turns 0.7 % more than every two-view
+  // estimate (hybrid_vo_bench_frontend --direct-gap), which that covers.
+  double rotation_calibration_sigma = 0.0;
+  // A share of the angle turned, per axis, that a full pair's rotation may be off beyond what the
+  // pair itself reports: on the rendered corridors (exact calibration) pairs turning more than 3
+  // degrees in a corner were off by about 1 % of their angle, four times what they claimed
+  // (rotation NEES 15.7), while straight ones were honest: the translation, held poorly while
+  // turning, takes some of the rotation with it. A rotation-only pair has no translation to
+  // trade (a pan over a photograph: 0.08 % of its angle).
+  double full_pair_turn_fraction = 0.01;
   // A CPU budget per frame (both threads): the front end drops its least useful work, level by
   // level (cpu_budget.h), while the recent frames exceed it. Off by default.
   CpuBudgetOptions budget;
@@ -96,8 +120,11 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   visit_fields(o.klt, prefixed("klt_", visit));
   visit_fields(o.estimator, prefixed("estimator_", visit));
   HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches);
+  HYBRID_VO_FIELDS(any_value(), o.rotation_only_pairs, o.model_selection);
+  HYBRID_VO_FIELDS(fraction(), o.rotation_keyframe_overlap);
   visit("rotation_drift_floor_deg", o.orientation.drift_floor_deg, non_negative());
   visit("rotation_calibration_sigma", o.rotation_calibration_sigma, non_negative());
+  visit("full_pair_turn_fraction", o.full_pair_turn_fraction, non_negative());
   visit("coast_blank_walls", o.orientation.coast_blank_walls);
   visit("translation_given_rotation", o.orientation.translation_given_rotation);
   HYBRID_VO_FIELDS(positive(), o.mono_scale);
@@ -131,13 +158,19 @@ struct VisualOdometryInput {
 enum class VoStatus {
   kFirstFrame,      // initialised the keyframe, no motion yet
   kOk,              // motion estimated and integrated
-  kLowParallax,     // too little motion to the keyframe; skipped
+  kLowParallax,     // too little motion to the keyframe and no rotation found; skipped
+  kRotationOnly,    // no translation seen: the rotation to the keyframe (and stereo's t)
   kTooFewFeatures,  // re-initialised on this frame, no motion
   kNoPose,          // the estimator found no trustworthy pose; keyframe kept, no motion
   kInvalidInput,    // empty image, invalid camera; frame ignored
   kReset,           // time went backwards: state cleared, this frame is the new first frame
 };
 const char* to_string(VoStatus status);
+// The frame has a pose to report: a motion (full or rotation-only), or the origin of a chain.
+inline bool answered(VoStatus status) {
+  return status == VoStatus::kOk || status == VoStatus::kRotationOnly ||
+         status == VoStatus::kFirstFrame || status == VoStatus::kReset;
+}
 
 struct VisualOdometryResult {
   VoStatus status = VoStatus::kInvalidInput;
@@ -146,6 +179,13 @@ struct VisualOdometryResult {
   TwoViewEstimate estimate;
   RelativePose motion;           // X_cur = R X_ref + t, t scaled (metric when scale_known)
   bool scale_known = false;
+  // kRotationOnly: the data showed no translation (rotation_only_pairs): t is zero in mono (its
+  // covariance a pair's length, mono_scale, per axis) or measured from the stereo points
+  // (scale_known). `parallax_px`: the points' median motion to the keyframe after the rotation
+  // (-1 unknown); `became_keyframe`: the frame took the keyframe's place (else the next frame is
+  // paired with the same keyframe: its parallax was too small for a baseline).
+  double parallax_px = -1.0;
+  bool became_keyframe = false;
   // Covariance of [rotation (left increment, rad), t as in `motion`]: the estimator's, with the
   // translation block scaled and, with a stereo scale, its variance along t added.
   Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Zero();
@@ -230,6 +270,7 @@ class VisualOdometry {
     Eigen::Matrix3d R_wc_covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     Matrix6d pose_covariance = Matrix6d::Zero();
+    int paired_points = -1;  // point matches of the first frame paired with it
   };
 
   // The stereo matching of features by id (the searches are left to the caller).
@@ -253,6 +294,10 @@ class VisualOdometry {
   bool begin_frame(Frame& f);
   void orient(Frame& f);
   void integrate(Frame& f);
+  // The frame's end for a pair without a baseline that leaves the keyframe in place: its pose is
+  // reported (the keyframe's position moved by the pair's t, the pair's orientation) and nothing
+  // is taken on.
+  VisualOdometryResult answer_without_keyframe(Frame& f);
 
   // vo_tracking.cc: the frame's points and segments, their matches with the keyframe's, and the
   // KLT re-detection for the next frame.
@@ -272,9 +317,14 @@ class VisualOdometry {
     kEstimate,     // estimated against the keyframe; kept as the next one when a pose is found
     kNewKeyframe,  // the keyframe from now on, without a motion: first frame, too few matches
     kSkip,         // left out, the keyframe staying: too little parallax
+    // Estimated and answered, the keyframe staying while its points are seen: too little
+    // parallax for a baseline (rotation_only_pairs)
+    kEstimateKeepKeyframe,
   };
   bool low_parallax(const Frame& f) const;
-  Pairing decide_keyframe(Frame& f) const;
+  Pairing decide_keyframe(Frame& f);
+  // A frame without a baseline leaves the keyframe in place while enough of its points are seen.
+  bool keeps_keyframe(const Frame& f) const;
   VisualOdometryResult keep_as_keyframe(Frame& f);  // the frame's end: it becomes the keyframe
   VisualOdometryResult skip_frame(Frame& f);        // the frame's end: the keyframe stays
   // `points` with their stereo points matched so far; `pending` the ids still without (see
@@ -282,8 +332,13 @@ class VisualOdometry {
   void make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> points,
                      std::vector<int64_t> pending);
 
-  // vo_estimation.cc: the pair's pose (false: none found).
+  // vo_estimation.cc: the pair's matches undistorted, its VPs and their priors; its full pose
+  // (false: none found), which may yet show no translation (f.rotation_only); or its rotation
+  // alone (false: none found).
+  TwoViewOptions pair_options() const;
+  void prepare_pair(Frame& f);
   bool estimate(Frame& f);
+  bool estimate_rotation(Frame& f);
 
   // vo_stereo_scale.cc: the stereo points of the frame and the keyframe, and the scale.
   void build_stereo_pyramids(Frame& f) const;  // the second thread
@@ -291,6 +346,12 @@ class VisualOdometry {
   void finish_stereo(Frame& f);   // (starts them if need be)
   void observe_scale(Frame& f) const;
   void fit_scale(Frame& f);
+  // A pair without a baseline, or with a rotation alone: in stereo its rotation and translation
+  // from the keyframe's stereo points (the rotation alone would take in a translation its points
+  // cannot show), into the estimate before it is oriented; then its translation (stereo's, or
+  // zero within mono_scale: only a baseline moves a mono position).
+  void measure_stereo_motion(Frame& f);
+  void fit_translation_without_baseline(Frame& f);
   // Of `points` (by id) in `pair`. With `predict` each search starts at the disparity of the
   // same id in the keyframe, when it has one.
   StereoFeatures stereo_features(const StereoPair& pair,
@@ -325,6 +386,9 @@ class VisualOdometry {
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   PoseCovarianceChain pose_covariance_;
   double last_stamp_ = -1e300;
+  // The last frame answered with a pose (rotation-only frames included): the rotation rate.
+  double last_answer_stamp_ = -1e300;
+  Eigen::Matrix3d last_answer_R_wc_ = Eigen::Matrix3d::Identity();
   // Kept across reset(): the machine's load does not change with the trajectory.
   CpuBudget budget_;
   // The work level's (apply_work_level): the segments' detection and description, and the share

@@ -71,6 +71,7 @@ class VoOrientation {
     PinholeCamera keyframe_camera, camera;
     double dt = 0.0;            // seconds from the keyframe
     bool vps_detected = false;  // the estimator looked for VPs (the map needs them)
+    bool rotation_only = false;  // the pair's data showed no translation
   };
   // The current camera's orientation from the keyframe's (`keyframe_R_wc`, its covariance) and
   // the pair. Changes nothing: advance() takes the outcome on.
@@ -81,12 +82,22 @@ class VoOrientation {
   // `motion_rotation_covariance` is the motion's rotation covariance as published.
   void advance(const Oriented& oriented, double dt,
                const Eigen::Matrix3d& motion_rotation_covariance);
+  // The rotation rate from a frame answered without advance(): its rotation R (X2 = R X1) since
+  // the last answered frame, `dt` seconds before.
+  void set_rate(const Eigen::Matrix3d& R, double dt);
+  // What reported_covariance() would be after advance(oriented, ..., motion_rotation_covariance),
+  // without taking the pair on: a frame answered against a keyframe that stays.
+  Eigen::Matrix3d reported_covariance(const Oriented& oriented,
+                                      const Eigen::Matrix3d& motion_rotation_covariance) const;
 
  private:
   const bool use_map_;
-  const double rotation_calibration_sigma_;
+  const double rotation_calibration_sigma_, full_pair_turn_fraction_;
   // The pairs' rotation sigmas (per axis) summed, and their squares, as corrections left them.
   double sigma_sum_ = 0.0, variance_sum_ = 0.0;
+  // Those sums with a pair taken on (advance()).
+  void accumulate(const Oriented& oriented, const Eigen::Matrix3d& motion_rotation_covariance,
+                  double* sigma_sum, double* variance_sum) const;
   // The first pair's VPs, as the map's seeds: the covariance of their fit at a third of the VP
   // detection's inlier threshold, plus a third of the estimator's VP threshold.
   const double seed_sigma_px_, seed_sigma_deg_;

@@ -68,6 +68,9 @@ struct PairRotation {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int segment_matches = 0;
   int vp_inliers = 0;
+  // The pair showed no translation (rotation_only.h): its points fix the rotation without the
+  // five-point model's ambiguity, so it is no blank wall for want of segments.
+  bool rotation_only = false;
   // The rotation the camera's last rotation rate gives over this pair's interval, if known.
   bool has_last_motion = false;
   Eigen::Matrix3d last_motion_R = Eigen::Matrix3d::Identity();

@@ -233,6 +233,7 @@ class VoNode {
   DirectionStructure map_structure_;
   DirectionMapStats map_stats_;
   int vp_priors_used_ = 0, vp_priors_rejected_ = 0, blank_wall_frames_ = 0, pairs_overruled_ = 0;
+  int rotation_only_frames_ = 0;
 
   InjectedLeak injected_leak_;  // the soak's own test only (scripts/soak --leak)
 };
