@@ -453,6 +453,12 @@ RelativePoseEstimate estimate_relative_pose(const PinholeCamera& camera1,
     }
     const double shared = honest.shared_error_px / camera2.mean_focal();
     est.covariance.topLeftCorner<3, 3>() += shared * shared * Eigen::Matrix3d::Identity();
+    // The translation's points count as fewer (pair_covariance.h): its correlations scaled too.
+    const double extra = std::sqrt(
+        std::max(1.0, point_matches / honest.independent_translation_points) /
+        std::max(1.0, point_matches / honest.independent_points));
+    est.covariance.bottomRows<3>() *= extra;
+    est.covariance.rightCols<3>() *= extra;
   }
   return finish(EstimationStatus::kOk);
 }

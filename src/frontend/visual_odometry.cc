@@ -167,7 +167,7 @@ void VisualOdometry::orient(Frame& f) {
   pair.camera = f.input.camera.pinhole;
   pair.dt = f.input.stamp - keyframe_.stamp;
   pair.vps_detected = f.vps_detected;
-  pair.rotation_only = f.rotation_only;
+  pair.independent_rotation = f.rotation_only || f.stereo_motion.ok;
   f.oriented = orientation_.orient(keyframe_.R_wc, keyframe_.R_wc_covariance, pair);
   f.result.orientation = f.oriented.estimate;
 }

@@ -92,7 +92,10 @@ bool VisualOdometry::estimate(Frame& f) {
     const MotionModelScores scores = select_motion_model(
         keyframe_.camera.pinhole, input.camera.pinhole, r.matches.points, est.point_inliers,
         est.pose, f.rotation.R, est.scales.point_px);
-    f.rotation_only = scores.rotation_only;
+    // A full model whose refinement found no covariance (its translation left it singular) does
+    // not hold that translation either: the rotation alone can say how well it is known (a pan
+    // whose tracks drifted: the map took such a pair for a blank wall and moved it by a degree).
+    f.rotation_only = scores.rotation_only || !est.covariance_valid;
     r.message = std::string(f.rotation_only ? "no translation seen" : "translation seen") +
                 " (GRIC per point: rotation " + std::to_string(scores.gric_rotation / scores.points) +
                 ", full " + std::to_string(scores.gric_full / scores.points) + ")";

@@ -109,7 +109,7 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
                                                                Eigen::Matrix3d::Identity());
   rotation.segment_matches = static_cast<int>(m.lines.size());
   rotation.vp_inliers = est.num_vp_inliers;
-  rotation.rotation_only = pair.rotation_only;
+  rotation.independent_rotation = pair.independent_rotation;
   if (pair.dt > 0.0) {
     const Eigen::Vector3d w = angular_velocity_ * pair.dt;
     rotation.has_last_motion = true;
@@ -152,7 +152,7 @@ VoOrientation::Oriented VoOrientation::orient(const Eigen::Matrix3d& keyframe_R_
   const Eigen::AngleAxisd turned(o.pose.R);
   const Eigen::Vector3d w = turned.angle() * turned.axis();
   const double c = rotation_calibration_sigma_,
-               k = pair.rotation_only ? 0.0 : full_pair_turn_fraction_;
+               k = pair.independent_rotation ? 0.0 : full_pair_turn_fraction_;
   o.motion_rotation_extra =
       (blank * blank + (c * c + k * k) * w.squaredNorm()) * Eigen::Matrix3d::Identity();
   return o;

@@ -233,6 +233,7 @@ void VisualOdometry::fit_scale(Frame& f) {
   // scale_known false.
   if (f.rotation_only || !f.baseline) return fit_translation_without_baseline(f);
   VisualOdometryResult& r = f.result;
+  r.baseline = true;
   const RelativePoseEstimate& est = r.estimate.estimate;
   const RelativePose& pose = f.oriented.pose;
   r.motion = pose;
@@ -265,8 +266,12 @@ void VisualOdometry::fit_scale(Frame& f) {
   const Eigen::Vector3d u = pose.t.normalized();
   if (all_finite(u))
     unknown.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() - u * u.transpose();
-  r.motion_covariance = metric_motion_covariance(est.covariance_valid ? est.covariance : unknown,
-                                                 pose.t, scale, scale_sigma);
+  // A blank wall's translation is as unknown as its rotation is uncertain: its points are sensor
+  // noise on a plane (the plain corridors' corners: 50-100 degrees off where the curvature
+  // claimed a few).
+  Eigen::Matrix<double, 6, 6> unit = est.covariance_valid ? est.covariance : unknown;
+  if (f.oriented.estimate.blank_wall) unit.bottomRightCorner<3, 3>() += unknown.bottomRightCorner<3, 3>();
+  r.motion_covariance = metric_motion_covariance(unit, pose.t, scale, scale_sigma);
   r.motion_covariance.topLeftCorner<3, 3>() += f.oriented.motion_rotation_extra;
   r.motion_covariance_valid = true;
 }

@@ -177,8 +177,9 @@ MapLocation DirectionMap::locate(const Eigen::Matrix3d& R, const Eigen::Matrix3d
 }
 
 MapLocation DirectionMap::locate(const Eigen::Matrix3d& R, const JointOrientation& predicted,
-                                 const std::vector<VpObservation>& observations) const {
-  return locate_with(R, predicted, observations, nullptr);
+                                 const std::vector<VpObservation>& observations,
+                                 bool widen) const {
+  return locate_with(R, predicted, observations, nullptr, widen);
 }
 
 MapLocation DirectionMap::locate_known(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
@@ -197,7 +198,7 @@ MapLocation DirectionMap::locate_known(const Eigen::Matrix3d& R,
 
 MapLocation DirectionMap::locate_with(const Eigen::Matrix3d& R, const JointOrientation& predicted,
                                       const std::vector<VpObservation>& observations,
-                                      const std::vector<int>* known_ids) const {
+                                      const std::vector<int>* known_ids, bool widen) const {
   const Eigen::Matrix3d P = predicted.orientation();
   MapLocation where;
   where.R_world_from_camera = R;
@@ -229,7 +230,7 @@ MapLocation DirectionMap::locate_with(const Eigen::Matrix3d& R, const JointOrien
     // sure of itself): three directions that pair only under a grown uncertainty, two of them
     // well apart, unambiguously, take it back. Not two: with junk VPs and few directions, two
     // pair by chance under a wide prior (TUM's panels).
-    const double sigma = options_.reacquisition_sigma_deg * kDeg;
+    const double sigma = (widen ? options_.reacquisition_sigma_deg : 0.0) * kDeg;
     const int needed = options_.wide_reacquisition_pairs;
     if (a.paired < needed && static_cast<int>(seen.size()) >= needed && sigma > 0.0) {
       const DirectionAssociation wide = associate_directions(

@@ -66,7 +66,7 @@ OrientationEstimate OrientationFilter::predict(const Eigen::Matrix3d& R1,
   e.covariance = P1;
   if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
   // A blank wall is the pair's, map or not.
-  e.blank_wall = !pair.rotation_only &&
+  e.blank_wall = !pair.independent_rotation &&
                  pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
   e.blank_wall_sigma_rad = e.blank_wall ? blank_wall_sigma(pair.R) : 0.0;
   e.location.joint =
@@ -84,7 +84,7 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   e.R_world_from_camera = R1;  // a non-finite input: nothing of the pair is taken
   e.covariance = P1;
   if (!all_finite(pair.R) || !all_finite(R1) || !all_finite(P1)) return e;
-  e.blank_wall = !pair.rotation_only &&
+  e.blank_wall = !pair.independent_rotation &&
                  pair.segment_matches <= options_.blank_wall_max_segments && pair.vp_inliers == 0;
   const double extra = e.blank_wall ? blank_wall_sigma(pair.R) : 0.0;
   e.blank_wall_sigma_rad = extra;
@@ -106,7 +106,11 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
   for (size_t k = 0; k < pair.vps.size(); ++k)
     if (k >= pair.vp_accepted.size() || pair.vp_accepted[k])
       e.observations.push_back(pair.vps[k]);
-  e.location = map_.locate(e.R_world_from_camera, joint, e.observations);
+  // A pair whose rotation its own points pin (independent_rotation) leaves the orientation as
+  // good as the keyframe's, and says so: no reason to widen it for a re-acquisition, which on
+  // pans over facades took oblique directions for the map's and moved exact pairs by degrees.
+  e.location = map_.locate(e.R_world_from_camera, joint, e.observations,
+                           !pair.independent_rotation);
   if (!options_.correct || !e.location.corrected) {
     // The prediction is what the map takes; its pairings still count as sightings.
     e.location.has_joint = true;
@@ -128,9 +132,10 @@ OrientationEstimate OrientationFilter::estimate(const Eigen::Matrix3d& R1,
 bool OrientationFilter::judge(const Eigen::Matrix3d& R1, const Eigen::Matrix3d& P1,
                               const PairRotation& pair, double extra_sigma_rad,
                               OrientationEstimate* e) const {
-  // A rotation-only pair's points pin its rotation (no plane's second motion, no translation to
-  // trade it for): nothing for the map to overrule.
-  if (pair.rotation_only) return false;
+  // A rotation fixed without an epipolar translation (a rotation alone, stereo 3D points) is
+  // pinned by its points (no plane's second motion, no translation to trade it for): nothing for
+  // the map to overrule.
+  if (pair.independent_rotation) return false;
   if (pair.vps.size() < 2 || pair.keyframe_vps.size() != pair.vps.size()) return false;
   // Only a pair whose pose refuses a VP that the keyframe saw as a direction of the map.
   const MapLocation before = map_.locate(R1, P1, pair.keyframe_vps);

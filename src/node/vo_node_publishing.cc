@@ -124,6 +124,7 @@ void VoNode::publish_relative_pose(const Frame& frame, const VisualOdometryResul
   const bool moved = result.status == VoStatus::kOk || result.status == VoStatus::kRotationOnly;
   rel.rotation_only = result.status == VoStatus::kRotationOnly;
   rel.parallax_px = result.parallax_px;
+  rel.baseline = moved && result.baseline;
   rel.transform = moved ? to_transform(result.motion.R, result.motion.t)
                         : to_transform(Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
   rel.scale_known = moved && result.scale_known;

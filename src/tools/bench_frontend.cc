@@ -360,7 +360,10 @@ int run(int argc, char** argv) {
       // the node's STATUS_SKIPPED; a failure to estimate counts as an error of 180 degrees. A
       // rotation-only pair has a rotation to compare, and no translation direction: it is left
       // out of the pose AUC.
-      const bool full = r.status == VoStatus::kOk, turned = r.status == VoStatus::kRotationOnly;
+      // A pair without a baseline has its rotation, and no translation direction either.
+      const bool full = r.status == VoStatus::kOk && r.baseline,
+                 turned = r.status == VoStatus::kRotationOnly ||
+                          (r.status == VoStatus::kOk && !r.baseline);
       if (i > 0 && reference >= 0 && reference < i && r.status != VoStatus::kLowParallax) {
         double error = 180.0;
         if (full || turned) {
@@ -397,14 +400,24 @@ int run(int argc, char** argv) {
               truth_orientation_sigma));
         }
         if (!turned) pose_errors.push_back(error);
-        if (verbose && (full || turned))
+        if (verbose && (full || turned)) {
+          // The direction's claimed sigma: the translation's covariance across t, per axis.
+          const Eigen::Vector3d u = r.motion.t.normalized();
+          const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - u * u.transpose();
+          const double direction_sigma =
+              full ? std::sqrt(0.5 * (across * r.motion_covariance.bottomRightCorner<3, 3>() *
+                                      across).trace()) / r.motion.t.norm() * 180.0 / M_PI
+                   : NAN;
           std::printf("pair %d: reference %d, %s, turned %.3f deg, parallax %.2f px, rotation "
-                      "error %.4f deg, NEES %.2f%s; %s\n",
+                      "error %.4f deg, NEES %.2f; direction error %.2f deg, sigma %.2f deg, NEES "
+                      "%.2f%s; %s\n",
                       i, reference, to_string(r.status),
                       Eigen::AngleAxisd(r.motion.R).angle() * 180.0 / M_PI, r.parallax_px,
-                      pair_rot_deg.back(),
-                      pair_rot_nees.back(), r.became_keyframe ? ", keyframe" : "",
+                      pair_rot_deg.back(), pair_rot_nees.back(),
+                      full ? pair_dir_deg.back() : NAN, direction_sigma,
+                      full ? pair_dir_nees.back() : NAN, r.became_keyframe ? ", keyframe" : "",
                       r.message.c_str());
+        }
       }
     }
     if (verbose) {
@@ -547,6 +560,27 @@ int run(int argc, char** argv) {
               answered_frames, frames - 1,
               frames > 1 ? 100.0 * answered_frames / (frames - 1) : 0.0, rotation_only, farthest,
               stereo ? "m" : "per-pair units");
+  // Starting to move (stereo, with a truth in the first camera's frame): where the camera went
+  // from its start, once it is 5 cm or more away, against where it truly went, and its length.
+  if (stereo && truth.size() == estimate.size() && !truth.empty()) {
+    double worst = -1.0, first_frame = -1;
+    double ratio = NAN;
+    for (size_t k = 0; k < truth.size(); ++k) {
+      // Both in the first camera's frame.
+      const Eigen::Vector3d t_true = truth[0].R.transpose() * (truth[k].c - truth[0].c);
+      const Eigen::Vector3d t_est = estimate[0].R.transpose() * (estimate[k].c - estimate[0].c);
+      if (t_true.norm() < 0.05) continue;
+      if (first_frame < 0) first_frame = static_cast<double>(k);
+      const double angle = std::atan2(t_true.cross(t_est).norm(), t_true.dot(t_est)) * 180 / M_PI;
+      worst = std::max(worst, angle);
+      ratio = t_est.norm() / t_true.norm();
+    }
+    if (first_frame >= 0)
+      std::printf("# from the start: once 5 cm away (frame %.0f on), the position's direction from "
+                  "the start at most %.2f deg off; its length at the last frame %.4f of the "
+                  "truth's\n",
+                  first_frame, worst, ratio);
+  }
   std::printf("median ms: total %.1f, front end %.1f, estimator %.1f; points %.1f, "
               "re-detection %.1f, lines %.1f, "
               "line matching %.1f, VPs %.1f, RANSAC %.1f; CPU per frame %.1f\n",

@@ -347,8 +347,8 @@ int main(int argc, char** argv) {
   std::vector<double> scale_ratios;
   // NEES of the estimated pairs' rotation and translation direction; NaN without a covariance.
   std::vector<double> pair_rot_nees, pair_dir_nees;
-  // Stereo: the metric translation's NEES (3 dof). Rotation-only pairs: their rotation is
-  // compared, they have no direction and stay out of the pose AUC.
+  // Stereo: the metric translation's NEES (3 dof). Rotation-only pairs and pairs without a
+  // baseline: their rotation is compared, they have no direction and stay out of the pose AUC.
   std::vector<double> pair_t_nees;
   int rotation_only = 0;
   std::printf("pair,stamp_ref,stamp,status,rot_err_deg,dir_err_deg,scale_ratio\n");
@@ -377,8 +377,8 @@ int main(int argc, char** argv) {
         if (m.scale_known)
           pair_t_nees.push_back(evaluation::translation_nees(
               t, t_gt, evaluation::covariance_block(m.covariance.data(), 3)));
-        if (m.rotation_only) {
-          ++rotation_only;
+        if (m.rotation_only || !m.baseline) {
+          rotation_only += m.rotation_only;
           std::printf("r,%.6f,%.6f,%d,%.4f,,\n", m.reference_stamp.toSec(),
                       m.header.stamp.toSec(), m.status, rot);
           continue;

@@ -183,9 +183,13 @@ struct VisualOdometryResult {
   // covariance a pair's length, mono_scale, per axis) or measured from the stereo points
   // (scale_known). `parallax_px`: the points' median motion to the keyframe after the rotation
   // (-1 unknown); `became_keyframe`: the frame took the keyframe's place (else the next frame is
-  // paired with the same keyframe: its parallax was too small for a baseline).
+  // paired with the same keyframe: its parallax was too small for a baseline). `baseline`: the
+  // translation is the pair's epipolar geometry's (its direction, and in stereo the scale's
+  // length); else too little parallax for one: zero within mono_scale in mono, the stereo
+  // points' in stereo.
   double parallax_px = -1.0;
   bool became_keyframe = false;
+  bool baseline = false;
   // Covariance of [rotation (left increment, rad), t as in `motion`]: the estimator's, with the
   // translation block scaled and, with a stereo scale, its variance along t added.
   Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Zero();

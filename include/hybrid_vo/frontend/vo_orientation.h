@@ -71,7 +71,9 @@ class VoOrientation {
     PinholeCamera keyframe_camera, camera;
     double dt = 0.0;            // seconds from the keyframe
     bool vps_detected = false;  // the estimator looked for VPs (the map needs them)
-    bool rotation_only = false;  // the pair's data showed no translation
+    // Its rotation rests on no epipolar translation (a rotation alone, or the stereo points'),
+    // so no share of the angle turned is traded with one.
+    bool independent_rotation = false;
   };
   // The current camera's orientation from the keyframe's (`keyframe_R_wc`, its covariance) and
   // the pair. Changes nothing: advance() takes the outcome on.

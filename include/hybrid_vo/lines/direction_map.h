@@ -142,8 +142,10 @@ class DirectionMap {
   // (nothing paired, ambiguous, or failing the gate). Invalid R or P: unchanged, nothing paired.
   MapLocation locate(const Eigen::Matrix3d& R, const Eigen::Matrix3d& P,
                      const std::vector<VpObservation>& observations) const;
+  // `widen`: whether a re-acquisition under a wider uncertainty than the prediction's may be
+  // tried (reacquisition_sigma_deg), for an orientation that may be off by more than it says.
   MapLocation locate(const Eigen::Matrix3d& R, const JointOrientation& predicted,
-                     const std::vector<VpObservation>& observations) const;
+                     const std::vector<VpObservation>& observations, bool widen = true) const;
 
   // The same with the pairs known (observation i with the direction of id direction_ids[i], -1:
   // none), e.g. from the keyframe's view of the same VPs: the rotation fitted to them, no search.
@@ -199,7 +201,7 @@ class DirectionMap {
   bool pinnable() const;
   MapLocation locate_with(const Eigen::Matrix3d& R, const JointOrientation& predicted,
                           const std::vector<VpObservation>& observations,
-                          const std::vector<int>* known_ids) const;
+                          const std::vector<int>* known_ids, bool widen = true) const;
   // The iterated joint update of the orientation and the directions by the pairs (observation k
   // of `seen` with map direction index j); false when it fails or is implausible.
   bool correct(const Eigen::Matrix3d& R, const std::vector<VpObservation>& seen,

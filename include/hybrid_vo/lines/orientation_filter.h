@@ -68,9 +68,10 @@ struct PairRotation {
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int segment_matches = 0;
   int vp_inliers = 0;
-  // The pair showed no translation (rotation_only.h): its points fix the rotation without the
-  // five-point model's ambiguity, so it is no blank wall for want of segments.
-  bool rotation_only = false;
+  // Its rotation rests on no epipolar translation (a rotation alone, rotation_only.h, or a stereo
+  // pair's 3D points): its points fix it without the five-point model's ambiguity, so it is no
+  // blank wall for want of segments, and the map cannot judge it.
+  bool independent_rotation = false;
   // The rotation the camera's last rotation rate gives over this pair's interval, if known.
   bool has_last_motion = false;
   Eigen::Matrix3d last_motion_R = Eigen::Matrix3d::Identity();

@@ -1,0 +1,204 @@
+// An answer for every frame (VisualOdometry without ROS): a camera at rest, a wheeled robot's
+// camera turning in place about a point behind it, a start from rest, and a pan in place over a
+// photograph made here. Every frame after the first has a pose; where the data show no
+// translation the pair is rotation-only, the mono position stays and the stereo one follows the
+// stereo points; the orientation follows the truth.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/geometry/pose_error.h"
+#include "hybrid_vo/render/pan_motion.h"
+#include "hybrid_vo/render/photo_pan.h"
+#include "hybrid_vo/render/sequence.h"
+
+namespace {
+
+using namespace hybrid_vo;
+using namespace hybrid_vo::render;
+
+constexpr double kDeg = 180.0 / M_PI;
+
+struct OdometryRun {
+  std::vector<VisualOdometryResult> results;
+  std::vector<Eigen::Matrix3d> R_true;  // camera into the first camera
+  std::vector<Eigen::Vector3d> c_true;  // camera centre in the first camera
+};
+
+VisualOdometryOptions sequential() {
+  VisualOdometryOptions o;
+  o.concurrent = false;
+  return o;
+}
+
+// A rendered sequence of `motion` through the odometry, mono or stereo.
+OdometryRun run_rendered(Motion motion, int frames, double rate, bool stereo, uint64_t seed) {
+  SequenceOptions options;
+  options.out_bag = "unused.bag";
+  options.frames = frames;
+  options.rate = rate;
+  options.width = 480;
+  options.height = 360;
+  options.supersampling = 1;
+  options.stereo = stereo;
+  options.motion = motion;
+  options.seed = seed;
+  if (motion == Motion::kTurn) options.scene = SceneType::kRoom;
+  const Sequence seq = make_sequence(options);
+  VisualOdometry vo(sequential());
+  OdometryRun run;
+  const CameraPose first = frame_pose(seq, 0);
+  for (int i = 0; i < frames; ++i) {
+    VisualOdometryInput in;
+    in.stamp = 1.0 + i / rate;
+    in.image = render_frame(seq, i).image;
+    in.camera.pinhole = seq.camera;
+    if (stereo) {
+      in.right_image = render_frame(seq, i, true).image;
+      in.baseline_m = options.baseline;
+    }
+    run.results.push_back(vo.process(in));
+    const CameraPose p = frame_pose(seq, i);
+    run.R_true.push_back(first.R_world_from_camera.transpose() * p.R_world_from_camera);
+    run.c_true.push_back(first.to_camera(p.centre));
+  }
+  return run;
+}
+
+double orientation_error_deg(const OdometryRun& run, int i) {
+  return rotation_error(run.results[i].R_wc, run.R_true[i]) * kDeg;
+}
+
+int answered_frames(const OdometryRun& run) {
+  int n = 0;
+  for (size_t i = 1; i < run.results.size(); ++i) n += answered(run.results[i].status);
+  return n;
+}
+
+int rotation_only_frames(const OdometryRun& run) {
+  int n = 0;
+  for (const VisualOdometryResult& r : run.results) n += r.status == VoStatus::kRotationOnly;
+  return n;
+}
+
+TEST(Answers, AtRestEveryFrameIsRotationOnlyAndThePoseStays) {
+  for (const bool stereo : {false, true}) {
+    const OdometryRun run = run_rendered(Motion::kRest, 16, 20.0, stereo, 3);
+    const int frames = static_cast<int>(run.results.size());
+    EXPECT_EQ(answered_frames(run), frames - 1) << (stereo ? "stereo" : "mono");
+    EXPECT_GE(rotation_only_frames(run), frames - 2);
+    for (int i = 1; i < frames; ++i) {
+      const VisualOdometryResult& r = run.results[i];
+      EXPECT_LT(orientation_error_deg(run, i), 0.05) << i;
+      // Mono: only a baseline moves the position; stereo: measured, zero within its noise.
+      EXPECT_LT(r.centre.norm(), stereo ? 0.01 : 1e-12) << i;
+      EXPECT_FALSE(r.baseline) << i;
+      EXPECT_TRUE(r.motion_covariance_valid) << i;
+      EXPECT_EQ(r.scale_known, stereo) << i;
+      EXPECT_TRUE(r.pose_covariance.allFinite()) << i;
+    }
+  }
+}
+
+// A wheeled robot's camera, 0.2 m in front of the axis it turns about at 30 deg/s: stereo
+// follows the arc (the stereo points give each pair without a baseline its translation), mono
+// answers every frame with its rotation.
+TEST(Answers, TurningInPlaceWithALeverArm) {
+  const OdometryRun stereo = run_rendered(Motion::kTurn, 60, 30.0, true, 2);
+  const int frames = static_cast<int>(stereo.results.size());
+  EXPECT_EQ(answered_frames(stereo), frames - 1);
+  double worst = 0.0;
+  int far = 0;
+  for (int i = 1; i < frames; ++i) {
+    EXPECT_LT(orientation_error_deg(stereo, i), 0.5) << i;
+    const Eigen::Vector3d c = stereo.results[i].centre, t = stereo.c_true[i];
+    if (t.norm() < 0.05) continue;
+    ++far;
+    worst = std::max(worst, std::atan2(c.cross(t).norm(), c.dot(t)) * kDeg);
+  }
+  ASSERT_GT(far, 10);
+  EXPECT_LT(worst, 8.0);
+  const double ratio = stereo.results.back().centre.norm() / stereo.c_true.back().norm();
+  EXPECT_NEAR(ratio, 1.0, 0.05);
+  RecordProperty("direction_from_start_worst_deg", std::to_string(worst));
+  RecordProperty("length_ratio", std::to_string(ratio));
+
+  const OdometryRun mono = run_rendered(Motion::kTurn, 60, 30.0, false, 2);
+  EXPECT_EQ(answered_frames(mono), frames - 1);
+  for (int i = 1; i < frames; ++i) EXPECT_LT(orientation_error_deg(mono, i), 1.0) << i;
+}
+
+// Still for a second, then walking: the stereo position stays within a centimetre while the
+// camera stands, and has the walk's length at the end.
+TEST(Answers, StartingFromRest) {
+  const OdometryRun run = run_rendered(Motion::kRamp, 45, 15.0, true, 4);
+  const int frames = static_cast<int>(run.results.size());
+  EXPECT_EQ(answered_frames(run), frames - 1);
+  for (int i = 1; i < 15; ++i) EXPECT_LT(run.results[i].centre.norm(), 0.01) << i;
+  const double ratio = run.results.back().centre.norm() / run.c_true.back().norm();
+  EXPECT_GT(run.c_true.back().norm(), 1.0);
+  EXPECT_NEAR(ratio, 1.0, 0.05);
+}
+
+// A photograph: grey blocks of every size and brightness, with their edges in a few directions.
+cv::Mat make_photo(int width, int height) {
+  cv::Mat photo(height, width, CV_8UC1, cv::Scalar(90));
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> x(0, width - 1), y(0, height - 1), size(8, 160), grey(0, 255);
+  for (int k = 0; k < 2500; ++k) {
+    const cv::Point a(x(rng), y(rng));
+    cv::rectangle(photo, a, a + cv::Point(size(rng), size(rng)), cv::Scalar(grey(rng)), cv::FILLED);
+  }
+  return photo;
+}
+
+// A pan in place: the virtual camera turns about its centre inside the photograph, which it sees
+// through the exact homography of a pure rotation. Every frame is answered, the mono position
+// never moves, the orientation stays within 0.1 degrees of the truth, and the rotation-only
+// pairs' covariance holds their error.
+TEST(Answers, APanInPlaceOverAPhotograph) {
+  const PinholeCamera photo_camera(1380.0, 1380.0, 767.5, 511.5, 1536, 1024);
+  const PinholeCamera camera(500.0, 500.0, 239.5, 179.5, 480, 360);
+  const PhotoPan pan(make_photo(photo_camera.width, photo_camera.height), photo_camera, camera,
+                     1.0, 5);
+  PanMotionOptions motion_options;
+  motion_options.frames = 45;
+  motion_options.yaw_deg = 6.0;
+  motion_options.pitch_deg = 2.0;
+  motion_options.roll_deg = 1.5;
+  const PanMotion motion = make_pan_motion(motion_options);
+  VisualOdometry vo(sequential());
+  int answered_count = 0, rotation_only = 0, inside = 0, with_covariance = 0;
+  for (int i = 0; i < motion_options.frames; ++i) {
+    VisualOdometryInput in;
+    in.stamp = 1.0 + motion.times[i];
+    in.image = pan.render_frame(motion, i);
+    in.camera.pinhole = camera;
+    const VisualOdometryResult r = vo.process(in);
+    if (i == 0) continue;
+    answered_count += answered(r.status);
+    rotation_only += r.status == VoStatus::kRotationOnly;
+    EXPECT_EQ(r.centre.norm(), 0.0) << i;
+    EXPECT_LT(rotation_error(r.R_wc, motion.R_first_from_camera(i)) * kDeg, 0.1) << i;
+    if (r.status != VoStatus::kRotationOnly || !r.motion_covariance_valid) continue;
+    // The pair's rotation against the truth between its keyframe and this frame.
+    const int reference = static_cast<int>(std::lround((r.reference_stamp - 1.0) * motion_options.rate));
+    const Eigen::Matrix3d R_true =
+        motion.R_first_from_camera(i).transpose() * motion.R_first_from_camera(reference);
+    const Eigen::AngleAxisd e(Eigen::Matrix3d(r.motion.R * R_true.transpose()));
+    const Eigen::Vector3d w = e.angle() * e.axis();
+    ++with_covariance;
+    inside += w.dot(r.motion_covariance.topLeftCorner<3, 3>().inverse() * w) < 7.815;
+  }
+  EXPECT_EQ(answered_count, motion_options.frames - 1);
+  EXPECT_GE(rotation_only, (motion_options.frames - 1) / 2);
+  ASSERT_GT(with_covariance, 10);
+  EXPECT_GE(inside, 0.8 * with_covariance);
+}
+
+}  // namespace
