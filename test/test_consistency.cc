@@ -157,6 +157,56 @@ TEST(Consistency, DirectionErrorIsTheAngleOnTheSphere) {
   EXPECT_NEAR(direction_nees(t_true, t_true, C), 0.0, 1e-12);
 }
 
+// A world direction seen by two cameras, each observation off by its own random tangent
+// covariance, a's sign drawn at random (a VP's sign is arbitrary); judged with each covariance
+// times `reported_scale`^2.
+std::vector<double> direction_pair_samples(unsigned seed, double reported_scale) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> sigma(0.05 * kDeg, 1.0 * kDeg);
+  auto observe = [&](const Eigen::Vector3d& d, Eigen::Matrix3d* C) {
+    Eigen::Matrix<double, 3, 2> B;
+    B.col(0) = d.unitOrthogonal();
+    B.col(1) = d.cross(B.col(0));
+    const Eigen::Vector2d s(sigma(rng), sigma(rng));
+    const Eigen::Matrix2d C2 = s.cwiseAbs2().asDiagonal();
+    *C = reported_scale * reported_scale * B * C2 * B.transpose();
+    const Eigen::Vector3d step = B * draw<2>(rng, C2);
+    return Eigen::Vector3d(exp_rotation(d.cross(step.normalized()) * step.norm()) * d);
+  };
+  std::vector<double> nees;
+  for (int i = 0; i < kSamples; ++i) {
+    const Eigen::Vector3d world = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Matrix3d R_a = random_rotation(rng), R_b = random_rotation(rng);  // world from camera
+    Eigen::Matrix3d C_a, C_b;
+    const Eigen::Vector3d d_a = (i % 2 ? -1.0 : 2.5) * observe(R_a.transpose() * world, &C_a);
+    const Eigen::Vector3d d_b = observe(R_b.transpose() * world, &C_b);
+    nees.push_back(direction_pair_nees(d_a, C_a, d_b, C_b, R_b.transpose() * R_a));
+  }
+  return nees;
+}
+
+TEST(Consistency, HonestDirectionPairGivesTheChiSquareWhateverTheSign) {
+  const NeesSummary s = summarize_nees(direction_pair_samples(5, 1.0), 2);
+  EXPECT_EQ(s.missing, 0);
+  EXPECT_NEAR(s.median, 1.386, 0.1);
+  EXPECT_NEAR(s.inside95, 0.95, 0.015);
+  // Covariances a third too small in sigma: nine times the NEES.
+  EXPECT_NEAR(summarize_nees(direction_pair_samples(5, 1.0 / 3.0), 2).median, 9 * 1.386, 1.0);
+}
+
+TEST(Consistency, DirectionPairWithoutAUsableCovarianceIsMissing) {
+  const Eigen::Vector3d d(0.0, 0.0, 1.0);
+  const Eigen::Matrix3d C = 1e-4 * (Eigen::Matrix3d::Identity() - d * d.transpose());
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  EXPECT_NEAR(direction_pair_nees(d, C, d, C, I), 0.0, 1e-12);
+  EXPECT_TRUE(std::isnan(direction_pair_nees(d, Eigen::Matrix3d::Zero(), d,
+                                             Eigen::Matrix3d::Zero(), I)));
+  EXPECT_TRUE(std::isnan(direction_pair_nees(Eigen::Vector3d::Zero(), C, d, C, I)));
+  EXPECT_TRUE(std::isnan(direction_pair_nees(d, C, Eigen::Vector3d::Constant(NAN), C, I)));
+  EXPECT_TRUE(std::isnan(direction_pair_nees(d, C, d, C, Eigen::Matrix3d::Constant(NAN))));
+}
+
 TEST(Consistency, UnusableCovariancesAreMissingNeverACrash) {
   const Eigen::Matrix3d R = exp_rotation(Eigen::Vector3d(0.01, -0.02, 0.03));
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();

@@ -98,6 +98,19 @@ double direction_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_tru
   return nees<2>(e, C);
 }
 
+double direction_pair_nees(const Eigen::Vector3d& d_a, const Eigen::Matrix3d& C_a,
+                           const Eigen::Vector3d& d_b, const Eigen::Matrix3d& C_b,
+                           const Eigen::Matrix3d& R_ba) {
+  if (!(d_a.norm() > 0.0) || !(d_b.norm() > 0.0) || !d_a.allFinite() || !d_b.allFinite() ||
+      !C_a.allFinite() || !C_b.allFinite() || !R_ba.allFinite())
+    return NAN;
+  Eigen::Vector3d carried = (R_ba * d_a).normalized();
+  const Eigen::Vector3d b = d_b.normalized();
+  if (carried.dot(b) < 0.0) carried = -carried;
+  // Both errors in b's tangent plane: a's covariance turns with it (the sign does not matter).
+  return direction_nees(b, carried, C_b + R_ba * C_a * R_ba.transpose());
+}
+
 double translation_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_true,
                         const Eigen::Matrix3d& covariance, double truth_sigma) {
   if (!t_est.allFinite() || !t_true.allFinite() || !usable_covariance(covariance, 3)) return NAN;

@@ -97,6 +97,10 @@ void VisualOdometry::match_points(Frame& f) const {
     undistort_matches(keyframe_.camera, f.input.camera, &points);
   RotationOnlyOptions options = options_.rotation_only;
   options.use_lines = options.use_vps = false;
+  // The parallax is below min_parallax_px only when over half the points fit a rotation within
+  // its threshold: a rotation with half the points as inliers is drawn in 50 samples but once in
+  // a hundred thousand (a forward drive has far fewer, and would use up every draw).
+  options.max_iterations = std::min(options.max_iterations, 50);
   f.rotation = estimate_rotation_only(keyframe_.camera.pinhole, f.input.camera.pinhole, points,
                                       options, options_.estimator.covariance);
   if (f.rotation.ok && f.rotation.parallax_px >= 0.0) f.parallax = f.rotation.parallax_px;

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <iostream>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -327,6 +328,13 @@ int run(int argc, char** argv) {
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
+  struct VpSighting {
+    int frame;
+    VpObservation observation;
+  };
+  constexpr int kVpNeesGap = 5;
+  std::map<int, VpSighting> vp_sightings;  // per map direction
+  std::vector<double> vp_nees;             // the VP observations' (2 dof)
   double farthest = 0.0;             // of the position from the first frame's
   // How the map of world directions served the estimated frames (as eval_trajectory prints it).
   int held = 0, reacquired = 0, rejected = 0, blank = 0, coasted = 0, overruled = 0;
@@ -388,10 +396,24 @@ int run(int argc, char** argv) {
                                                    truth_direction_sigma)
                       : NAN);
           }
-          if (r.scale_known)
+          if (r.scale_known) {
             pair_t_nees.push_back(valid ? evaluation::translation_nees(
                                               r.motion.t, truth_pose.t, C.bottomRightCorner<3, 3>())
                                         : NAN);
+            if (verbose) {
+              // Along t (the scale) and across it (the direction), error and sigma in metres.
+              const Eigen::Vector3d u = r.motion.t.norm() > 0 ? r.motion.t.normalized()
+                                                              : Eigen::Vector3d::UnitZ();
+              const Eigen::Vector3d e = r.motion.t - truth_pose.t;
+              const Eigen::Matrix3d Ct = C.bottomRightCorner<3, 3>();
+              std::printf("stereo pair %d: t %.4f m, error along %.4f (sigma %.4f), across %.4f "
+                          "(sigma %.4f), NEES %.2f\n",
+                          i, r.motion.t.norm(), e.dot(u), std::sqrt(u.dot(Ct * u)),
+                          (e - e.dot(u) * u).norm(),
+                          std::sqrt(std::max(0.0, Ct.trace() - u.dot(Ct * u))),
+                          pair_t_nees.back());
+            }
+          }
           // The orientation's covariance as the node reports it: the pose covariance's rotation
           // block (VoOrientation::reported_covariance).
           orientation_nees.push_back(evaluation::orientation_nees(
@@ -418,6 +440,24 @@ int run(int argc, char** argv) {
                       full ? pair_dir_nees.back() : NAN, r.became_keyframe ? ", keyframe" : "",
                       r.message.c_str());
         }
+      }
+    }
+    // The VP observations' covariance against the truth: each map direction's sighting with the
+    // last one it was compared with, at least kVpNeesGap frames before (segments tracked between
+    // nearby frames share their errors), under the true rotation between the two frames.
+    if (static_cast<int>(gt.size()) > i) {
+      const std::vector<VpObservation>& seen = r.orientation.observations;
+      const std::vector<int>& ids = r.orientation.location.direction_id;
+      for (size_t k = 0; k < seen.size() && k < ids.size(); ++k) {
+        if (ids[k] < 0) continue;
+        const auto last = vp_sightings.find(ids[k]);
+        if (last != vp_sightings.end() && i - last->second.frame < kVpNeesGap) continue;
+        if (last != vp_sightings.end())
+          vp_nees.push_back(evaluation::direction_pair_nees(
+              last->second.observation.direction, last->second.observation.covariance,
+              seen[k].direction, seen[k].covariance,
+              gt[i].R_wc.transpose() * gt[last->second.frame].R_wc));
+        vp_sightings[ids[k]] = {i, seen[k]};
       }
     }
     if (verbose) {
@@ -642,6 +682,8 @@ int run(int argc, char** argv) {
                 3, "estimated frames");
     if (stereo)
       consistency("metric translation per pair", 0.0, pair_t_nees, 3, "pairs with a scale");
+    consistency("VP observation against the same direction's earlier one", 0.0, vp_nees, 2,
+                "sightings compared");
   }
   if (direct_gap > 0)
     print_direct_check(images, input.camera, odometry, truth, direct_gap,

@@ -135,6 +135,7 @@ def write_bags(directory, honest):
                 continue
             m.reference_stamp = rospy.Time.from_sec(stamps[k - 1])
             m.status = MotionEstimate.STATUS_OK
+            m.baseline = True  # as the node marks a pair whose translation its epipolar geometry gives
             R_pair = R_true[k].T @ R_true[k - 1]
             d_pair = R_true[k].T @ (c_true[k - 1] - c_true[k])
             d_pair /= np.linalg.norm(d_pair)

@@ -44,6 +44,14 @@ double rotation_nees(const Eigen::Matrix3d& R_est, const Eigen::Matrix3d& R_true
 double direction_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_true,
                       const Eigen::Matrix3d& covariance, double truth_sigma = 0.0);
 
+// NEES of two observations of one world direction (2 dof), e.g. a VP seen in frames a and b, under
+// the true rotation R_ba from a's camera into b's: a's direction carried into b against b's, with
+// both covariances (unit directions, tangent plane, rad^2). A VP has either sign: a's is flipped
+// to b's side. NaN when either direction is zero or their summed covariance is not usable.
+double direction_pair_nees(const Eigen::Vector3d& d_a, const Eigen::Matrix3d& C_a,
+                           const Eigen::Vector3d& d_b, const Eigen::Matrix3d& C_b,
+                           const Eigen::Matrix3d& R_ba);
+
 // NEES of a metric translation (3 dof; stereo pairs): the error t_est - t_true under covariance
 // + truth_sigma^2 I (metres). NaN when the covariance is not usable with full rank.
 double translation_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_true,
