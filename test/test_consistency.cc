@@ -207,6 +207,28 @@ TEST(Consistency, DirectionPairWithoutAUsableCovarianceIsMissing) {
   EXPECT_TRUE(std::isnan(direction_pair_nees(d, C, d, C, Eigen::Matrix3d::Constant(NAN))));
 }
 
+TEST(Consistency, SightingsAreComparedAtLeastTheGapApartPerDirection) {
+  DirectionSightings sightings(5);
+  const Eigen::Matrix3d C = 1e-6 * Eigen::Matrix3d::Identity();
+  std::mt19937 rng(9);
+  std::vector<Eigen::Matrix3d> R_true;
+  for (int frame = 0; frame <= 12; ++frame) {
+    R_true.push_back(random_rotation(rng));
+    // Direction 0 exact at every frame, direction 1 (from frame 3 on) 1 mrad off at frame 8.
+    sightings.add(frame, 0, R_true[frame].transpose() * Eigen::Vector3d::UnitX(), C, R_true[frame]);
+    if (frame >= 3) {
+      Eigen::Vector3d d = R_true[frame].transpose() * Eigen::Vector3d::UnitY();
+      if (frame == 8) d = exp_rotation(1e-3 * R_true[frame].transpose() * Eigen::Vector3d::UnitZ()) * d;
+      sightings.add(frame, 1, d, C, R_true[frame]);
+    }
+  }
+  // In the order compared: direction 0 at 5 (against 0), 1 at 8 (against 3), 0 at 10 (against 5).
+  ASSERT_EQ(sightings.nees().size(), 3u);
+  EXPECT_NEAR(sightings.nees()[0], 0.0, 1e-9);
+  EXPECT_NEAR(sightings.nees()[1], 1e-6 / 2e-6, 1e-3);  // (1 mrad)^2 over both covariances
+  EXPECT_NEAR(sightings.nees()[2], 0.0, 1e-9);
+}
+
 TEST(Consistency, UnusableCovariancesAreMissingNeverACrash) {
   const Eigen::Matrix3d R = exp_rotation(Eigen::Vector3d(0.01, -0.02, 0.03));
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();

@@ -177,6 +177,26 @@ TEST(Replay, RenderedStereoSequence) {
     EXPECT_TRUE(std::isfinite(vp.sigma_deg) && vp.sigma_deg > 0.0) << "direction " << vp.id;
     EXPECT_TRUE(std::isfinite(vp.last_chi2) && vp.last_chi2 >= 0.0) << "direction " << vp.id;
     seen += vp.seen;
+    // A direction seen carries the frame's own observation (camera frame) with a covariance in
+    // the plane orthogonal to it, near the map's direction in the camera; one unseen, zeros.
+    const Eigen::Vector3d observed(vp.observation_camera.x, vp.observation_camera.y,
+                                   vp.observation_camera.z);
+    const Eigen::Matrix3d C =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(vp.observation_covariance.data());
+    if (vp.seen) {
+      const Eigen::Vector3d mapped(vp.direction_camera.x, vp.direction_camera.y,
+                                   vp.direction_camera.z);
+      EXPECT_NEAR(observed.norm(), 1.0, 1e-6) << "direction " << vp.id;
+      EXPECT_GT(std::abs(observed.dot(mapped.normalized())), std::cos(2.0 / kDeg))
+          << "direction " << vp.id;
+      EXPECT_TRUE(C.allFinite() && C.isApprox(C.transpose(), 1e-9)) << C;
+      EXPECT_LT((C * observed).norm(), 1e-9 * std::max(1e-12, C.norm())) << C;
+      EXPECT_GT(C.trace(), 0.0);
+      EXPECT_LT(std::sqrt(C.trace()) * kDeg, 5.0) << "direction " << vp.id;
+    } else {
+      EXPECT_EQ(observed.norm(), 0.0) << "direction " << vp.id;
+      EXPECT_EQ(C.norm(), 0.0) << "direction " << vp.id;
+    }
     if (vp.confident) {
       ++confirmed;
       EXPECT_LT(vp.sigma_deg, 0.5) << "direction " << vp.id;

@@ -111,6 +111,17 @@ double direction_pair_nees(const Eigen::Vector3d& d_a, const Eigen::Matrix3d& C_
   return direction_nees(b, carried, C_b + R_ba * C_a * R_ba.transpose());
 }
 
+void DirectionSightings::add(int frame, int id, const Eigen::Vector3d& d, const Eigen::Matrix3d& C,
+                             const Eigen::Matrix3d& R_true) {
+  const auto last = last_.find(id);
+  if (last != last_.end()) {
+    if (frame - last->second.frame < min_gap_) return;
+    nees_.push_back(direction_pair_nees(last->second.d, last->second.C, d, C,
+                                        R_true.transpose() * last->second.R_true));
+  }
+  last_[id] = {frame, d, C, R_true};
+}
+
 double translation_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_true,
                         const Eigen::Matrix3d& covariance, double truth_sigma) {
   if (!t_est.allFinite() || !t_true.allFinite() || !usable_covariance(covariance, 3)) return NAN;

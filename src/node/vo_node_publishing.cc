@@ -243,7 +243,18 @@ void VoNode::publish_vanishing_points(const ros::Time& stamp, const VisualOdomet
     vp.hits = d.hits;
     vp.age = map.frames() - d.created;
     vp.confident = d.confirmed;
-    vp.seen = std::find(seen.begin(), seen.end(), d.id) != seen.end();
+    const auto paired = std::find(seen.begin(), seen.end(), d.id);
+    vp.seen = paired != seen.end();
+    const size_t k = paired - seen.begin();
+    std::vector<int> index;
+    const std::vector<VpObservation> used =
+        vp.seen && k < result.orientation.observations.size()
+            ? map.usable({result.orientation.observations[k]}, &index)
+            : std::vector<VpObservation>();
+    if (!used.empty()) {
+      vp.observation_camera = to_vector(used[0].direction);
+      for (int i = 0; i < 9; ++i) vp.observation_covariance[i] = used[0].covariance(i / 3, i % 3);
+    }
     vp.sigma_deg = d.sigma_deg();
     vp.last_chi2 = d.last_chi2;
     vp.last_gate_passed = d.disagreements == 0;

@@ -14,7 +14,6 @@
 #include <cstdlib>
 #include <ctime>
 #include <iostream>
-#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -328,13 +327,7 @@ int run(int argc, char** argv) {
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
-  struct VpSighting {
-    int frame;
-    VpObservation observation;
-  };
-  constexpr int kVpNeesGap = 5;
-  std::map<int, VpSighting> vp_sightings;  // per map direction
-  std::vector<double> vp_nees;             // the VP observations' (2 dof)
+  evaluation::DirectionSightings vp_sightings;  // the VP observations' NEES (2 dof)
   double farthest = 0.0;             // of the position from the first frame's
   // How the map of world directions served the estimated frames (as eval_trajectory prints it).
   int held = 0, reacquired = 0, rejected = 0, blank = 0, coasted = 0, overruled = 0;
@@ -442,23 +435,15 @@ int run(int argc, char** argv) {
         }
       }
     }
-    // The VP observations' covariance against the truth: each map direction's sighting with the
-    // last one it was compared with, at least kVpNeesGap frames before (segments tracked between
-    // nearby frames share their errors), under the true rotation between the two frames.
+    // The VP observations' covariance against the truth.
     if (static_cast<int>(gt.size()) > i) {
       const std::vector<VpObservation>& seen = r.orientation.observations;
       const std::vector<int>& ids = r.orientation.location.direction_id;
-      for (size_t k = 0; k < seen.size() && k < ids.size(); ++k) {
-        if (ids[k] < 0) continue;
-        const auto last = vp_sightings.find(ids[k]);
-        if (last != vp_sightings.end() && i - last->second.frame < kVpNeesGap) continue;
-        if (last != vp_sightings.end())
-          vp_nees.push_back(evaluation::direction_pair_nees(
-              last->second.observation.direction, last->second.observation.covariance,
-              seen[k].direction, seen[k].covariance,
-              gt[i].R_wc.transpose() * gt[last->second.frame].R_wc));
-        vp_sightings[ids[k]] = {i, seen[k]};
-      }
+      std::vector<int> index;
+      const std::vector<VpObservation> used = vo.direction_map().usable(seen, &index);
+      for (size_t u = 0; u < used.size(); ++u)
+        if (index[u] < static_cast<int>(ids.size()) && ids[index[u]] >= 0)
+          vp_sightings.add(i, ids[index[u]], used[u].direction, used[u].covariance, gt[i].R_wc);
     }
     if (verbose) {
       // Per frame: status, VPs and what became of their priors, and the tracks.
@@ -682,8 +667,8 @@ int run(int argc, char** argv) {
                 3, "estimated frames");
     if (stereo)
       consistency("metric translation per pair", 0.0, pair_t_nees, 3, "pairs with a scale");
-    consistency("VP observation against the same direction's earlier one", 0.0, vp_nees, 2,
-                "sightings compared");
+    consistency("VP observation against the same direction's earlier one", 0.0,
+                vp_sightings.nees(), 2, "sightings compared");
   }
   if (direct_gap > 0)
     print_direct_check(images, input.camera, odometry, truth, direct_gap,

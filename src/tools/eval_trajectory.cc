@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <geometry_msgs/PoseStamped.h>
 #include <hybrid_vo/MotionEstimate.h>
+#include <hybrid_vo/VanishingPoints.h>
 #include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -92,6 +93,7 @@ struct Run {
   std::vector<hybrid_vo::MotionEstimate> motions;
   int scale_known = 0;
   std::vector<OdometrySample> odometry;
+  std::vector<hybrid_vo::VanishingPoints> vanishing_points;  // ~vanishing_points, one a frame
 };
 
 bool any_nonzero(const boost::array<double, 36>& values) {
@@ -123,6 +125,8 @@ bool read_run(const std::string& path, Run* run, std::string* error) {
       run->scale_known += motion->scale_known;
     } else if (const auto o = m.instantiate<nav_msgs::Odometry>()) {
       odometry.push_back(*o);
+    } else if (const auto v = m.instantiate<hybrid_vo::VanishingPoints>()) {
+      run->vanishing_points.push_back(*v);
     }
   }
   bag.close();
@@ -260,6 +264,33 @@ evaluation::NeesSummary orientation_consistency(const std::vector<OdometrySample
                 100.0 * with_twist / odometry.size());
   print_consistency(what, truth_sigma, summary, "poses", more);
   return summary;
+}
+
+// The VP observations on ~vanishing_points (each direction seen, with its covariance) against
+// the truth: a sighting against the same direction's at least 5 messages before, under the true
+// rotation between the two frames (evaluation::DirectionSightings). Runs recorded before the
+// observations were published carry none: no line.
+void vp_observation_consistency(const std::vector<hybrid_vo::VanishingPoints>& messages,
+                                const Trajectory& gt, double tolerance) {
+  evaluation::DirectionSightings sightings;
+  int observed = 0;
+  for (size_t i = 0; i < messages.size(); ++i) {
+    StampedPose truth;
+    if (!evaluation::pose_at(gt, messages[i].header.stamp.toSec(), tolerance, &truth)) continue;
+    for (const hybrid_vo::VanishingPoint& vp : messages[i].vps) {
+      const Eigen::Vector3d d(vp.observation_camera.x, vp.observation_camera.y,
+                              vp.observation_camera.z);
+      if (!vp.seen || !(d.norm() > 0.0)) continue;
+      ++observed;
+      sightings.add(static_cast<int>(i), vp.id, d,
+                    Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+                        vp.observation_covariance.data()),
+                    truth.R);
+    }
+  }
+  if (observed > 0)
+    print_consistency("VP observation against the same direction's earlier one", 0.0,
+                      evaluation::summarize_nees(sightings.nees(), 2), "sightings compared", "");
 }
 
 }  // namespace
@@ -466,6 +497,7 @@ int main(int argc, char** argv) {
     print_consistency("translation direction per pair", truth_direction_sigma,
                       evaluation::summarize_nees(pair_dir_nees, 2), "estimated pairs", "");
     orient_nees = orientation_consistency(run.odometry, gt, tolerance, truth_orientation_sigma);
+    vp_observation_consistency(run.vanishing_points, gt, tolerance);
   }
   // Processing time per frame as the node measured it (MotionEstimate), skipped frames included:
   // what bounds the frame rate through the node. Then where it goes, stage by stage (the stages

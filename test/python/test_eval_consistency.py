@@ -1,7 +1,8 @@
 """hybrid_vo_eval_trajectory's `# consistency:` lines on a recording made up here: each pair's
 errors drawn from the covariance its MotionEstimate carries, and ~odometry whose orientation
 errors are drawn from its pose covariance about the odom frame's axes, for a body (base_link)
-turned against the camera as KITTI's car is. Honest covariances read the chi-square's median
+turned against the camera as KITTI's car is, and ~vanishing_points whose observations are drawn
+from the covariances they carry. Honest covariances read the chi-square's median
 NEES (2.366 for 3 dof, 1.386 for 2), the truth-noise options are added, and the all-zero
 covariances of a node that publishes none count as missing."""
 import re
@@ -12,7 +13,7 @@ import pytest
 import rosbag
 import rospy
 from geometry_msgs.msg import PoseStamped, TransformStamped
-from hybrid_vo.msg import MotionEstimate
+from hybrid_vo.msg import MotionEstimate, VanishingPoint, VanishingPoints
 from nav_msgs.msg import Odometry
 from tf2_msgs.msg import TFMessage
 
@@ -72,6 +73,30 @@ def tangent_basis(d):
     return np.stack([b1, np.cross(d, b1)], axis=1)
 
 
+def write_vanishing_points(bag, stamps, R_true):
+    """Four world directions seen at every frame, each observation off by its own random tangent
+    covariance and of a random sign (a VP's sign is arbitrary); its own generator, so that the
+    rest of the recording is the same with or without them."""
+    rng = np.random.default_rng(48)
+    world = [np.eye(3)[0], np.eye(3)[1], np.eye(3)[2], np.array([0.6, 0.8, 0.0])]
+    for k, t in enumerate(stamps):
+        message = VanishingPoints()
+        message.header.stamp = rospy.Time.from_sec(t)
+        message.header.frame_id = "odom"
+        for i, w in enumerate(world):
+            d = R_true[k].T @ w
+            B = tangent_basis(d)
+            C2 = np.diag(rng.uniform(0.05, 0.5, 2) * DEG) ** 2
+            step = B @ rng.multivariate_normal(np.zeros(2), C2)
+            observed = exp_rotation(np.cross(d, step)) @ d
+            vp = VanishingPoint(id=i, seen=True)
+            vp.observation_camera.x, vp.observation_camera.y, vp.observation_camera.z = \
+                observed * rng.choice([-1.0, 1.0])
+            vp.observation_covariance = list((B @ C2 @ B.T).ravel())
+            message.vps.append(vp)
+        bag.write("/hybrid_vo/vanishing_points", message, message.header.stamp)
+
+
 def write_bags(directory, honest):
     """A run (relative poses, tf, odometry) and its ground truth; with `honest` false every
     covariance is zero, as the node's odometry had it before issue 43."""
@@ -94,6 +119,8 @@ def write_bags(directory, honest):
             bag.write("/ground_truth/pose", p, p.header.stamp)
     odometry_sigma = np.array([0.05, 0.2, 2.0]) * DEG  # about odom's x, y and its vertical z
     with rosbag.Bag(str(run_bag), "w") as bag:
+        if honest:
+            write_vanishing_points(bag, stamps, R_true)
         static = TransformStamped()
         static.header.frame_id, static.child_frame_id = "base_link", "camera"
         set_pose(static.transform, R_BODY_CAMERA, np.array([1.0, 0.0, 1.5]))
@@ -196,18 +223,29 @@ def test_honest_covariances_read_the_chi_square(honest):
         assert abs(float(summary[key]) - 95.0) < 4.0, summary
 
 
+def test_vp_observations_read_the_chi_square(honest):
+    lines, _ = evaluate(*honest)
+    line = lines["VP observation against the same direction's earlier one"]
+    # Four directions, each compared every fifth message: 4 x 80.
+    assert "; 320 of 320 sightings compared with a covariance" in line, line
+    assert abs(median_of(line) - 1.386) < 0.25, line
+
+
 def test_truth_noise_is_added(honest):
     # 5 degrees per axis of the truth's own noise dwarfs every error drawn here.
     lines, _ = evaluate(*honest, "--truth-rotation-sigma-deg", "5", "--truth-direction-sigma-deg",
                         "5", "--truth-orientation-sigma-deg", "5")
-    assert len(lines) == 3, lines
-    for line in lines.values():
+    assert len(lines) == 4, lines
+    for what, line in lines.items():
+        if what.startswith("VP observation"):  # two observations, no truth of their own
+            continue
         assert "truth sigma 5 deg" in line, line
         assert median_of(line) < 0.3, line
 
 
 def test_zero_covariances_are_missing(tmp_path):
     lines, summary = evaluate(*write_bags(tmp_path, honest=False))
+    assert not any(what.startswith("VP observation") for what in lines), lines  # none recorded
     assert "NEES: none of 400 estimated pairs with a covariance" in lines["rotation per pair"]
     assert "NEES: none of 400 poses with a covariance; 0.0 % of 401 odometry messages" \
         in lines["orientation against the first frame"]

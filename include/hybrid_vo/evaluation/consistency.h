@@ -6,6 +6,7 @@
 // Angles and truth noise are in radians here; the tools take degrees.
 
 #include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,29 @@ double direction_nees(const Eigen::Vector3d& t_est, const Eigen::Vector3d& t_tru
 double direction_pair_nees(const Eigen::Vector3d& d_a, const Eigen::Matrix3d& C_a,
                            const Eigen::Vector3d& d_b, const Eigen::Matrix3d& C_b,
                            const Eigen::Matrix3d& R_ba);
+
+// The VP observations' NEES along a run: each sighting of a map direction (its id) against the
+// last one it was compared with, at least `min_gap` frames before (nearby frames share tracked
+// segments and their errors), under the true rotation between the two frames.
+class DirectionSightings {
+ public:
+  explicit DirectionSightings(int min_gap = 5) : min_gap_(min_gap) {}
+  // d, C: the observation in the camera frame (direction_pair_nees); R_true: the true
+  // camera-to-world rotation of `frame`.
+  void add(int frame, int id, const Eigen::Vector3d& d, const Eigen::Matrix3d& C,
+           const Eigen::Matrix3d& R_true);
+  const std::vector<double>& nees() const { return nees_; }
+
+ private:
+  struct Sighting {
+    int frame;
+    Eigen::Vector3d d;
+    Eigen::Matrix3d C, R_true;
+  };
+  int min_gap_;
+  std::map<int, Sighting> last_;
+  std::vector<double> nees_;
+};
 
 // NEES of a metric translation (3 dof; stereo pairs): the error t_est - t_true under covariance
 // + truth_sigma^2 I (metres). NaN when the covariance is not usable with full rank.

@@ -187,12 +187,13 @@ class DirectionMap {
   const DirectionMapOptions& options() const { return options_; }
   // Forgets every direction (ids keep increasing).
   void reset();
+  // Observations as the association takes them: unit directions with their covariances, in the
+  // camera frame (a missing one the default sigma, each at least the floor); invalid ones are
+  // left out and `index` maps back. What ~vanishing_points publishes and the tools check.
+  std::vector<VpObservation> usable(const std::vector<VpObservation>& observations,
+                                    std::vector<int>* index) const;
 
  private:
-  // Observations as the association takes them: unit directions with their covariances, in the
-  // camera frame; invalid ones are left out and `index` maps back.
-  std::vector<VpObservation> usable(const std::vector<VpObservation>& observations,
-                                           std::vector<int>* index) const;
   std::vector<MapLandmark> landmarks(bool confirmed_only) const;
   // Whether two of the association's directions (indices into `confirmed`) are
   // reacquisition_min_angle_deg apart.
