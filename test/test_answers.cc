@@ -1,8 +1,9 @@
 // An answer for every frame (VisualOdometry without ROS): a camera at rest, a wheeled robot's
-// camera turning in place about a point behind it, a start from rest, and a pan in place over a
-// photograph made here. Every frame after the first has a pose; where the data show no
-// translation the pair is rotation-only, the mono position stays and the stereo one follows the
-// stereo points; the orientation follows the truth.
+// camera turning in place about a point behind it, a start from rest, small stereo baselines at
+// 30 Hz, and a pan in place over a photograph made here. Every frame after the first has a
+// pose; where the data show no translation the pair is rotation-only, the mono position stays
+// and the stereo one follows the stereo points; the orientation follows the truth.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -37,7 +38,9 @@ VisualOdometryOptions sequential() {
 }
 
 // A rendered sequence of `motion` through the odometry, mono or stereo.
-OdometryRun run_rendered(Motion motion, int frames, double rate, bool stereo, uint64_t seed) {
+OdometryRun run_rendered(Motion motion, int frames, double rate, bool stereo, uint64_t seed,
+                         const VisualOdometryOptions& vo_options = sequential(),
+                         bool room = false) {
   SequenceOptions options;
   options.out_bag = "unused.bag";
   options.frames = frames;
@@ -48,9 +51,9 @@ OdometryRun run_rendered(Motion motion, int frames, double rate, bool stereo, ui
   options.stereo = stereo;
   options.motion = motion;
   options.seed = seed;
-  if (motion == Motion::kTurn) options.scene = SceneType::kRoom;
+  if (room || motion == Motion::kTurn) options.scene = SceneType::kRoom;
   const Sequence seq = make_sequence(options);
-  VisualOdometry vo(sequential());
+  VisualOdometry vo(vo_options);
   OdometryRun run;
   const CameraPose first = frame_pose(seq, 0);
   for (int i = 0; i < frames; ++i) {
@@ -143,6 +146,38 @@ TEST(Answers, StartingFromRest) {
   const double ratio = run.results.back().centre.norm() / run.c_true.back().norm();
   EXPECT_GT(run.c_true.back().norm(), 1.0);
   EXPECT_NEAR(ratio, 1.0, 0.05);
+}
+
+// Walking through a room at 30 Hz the pairs have a few pixels of parallax: their epipolar
+// direction is poor, the stereo points' depths are not. Where the stereo points' translation is
+// clearly the better (stereo_translation_margin) the pair takes it: the pairs' translation
+// direction (median) and the position at the end are nearer the truth than with the epipolar
+// direction alone (seeds 5-7: 1.5-2.8 against 3.8-11.5 degrees).
+TEST(Answers, SmallBaselinesTakeTheStereoPointsTranslation) {
+  auto errors = [](const OdometryRun& run, double rate) {
+    std::vector<double> pair_errors;
+    for (size_t i = 1; i < run.results.size(); ++i) {
+      const VisualOdometryResult& r = run.results[i];
+      const int ref = static_cast<int>(std::lround((r.reference_stamp - 1.0) * rate));
+      if (!r.baseline || !r.scale_known || ref < 0 || ref >= static_cast<int>(i)) continue;
+      const Eigen::Vector3d t_true = run.R_true[i].transpose() * (run.c_true[ref] - run.c_true[i]);
+      pair_errors.push_back(std::atan2(r.motion.t.cross(t_true).norm(), r.motion.t.dot(t_true)) * kDeg);
+    }
+    std::sort(pair_errors.begin(), pair_errors.end());
+    return std::make_pair(pair_errors.empty() ? NAN : pair_errors[pair_errors.size() / 2],
+                          (run.results.back().centre - run.c_true.back()).norm());
+  };
+  VisualOdometryOptions epipolar = sequential();
+  epipolar.stereo_translation_margin = 0.0;
+  const auto [pair_with, end_with] =
+      errors(run_rendered(Motion::kWalk, 40, 30.0, true, 5, sequential(), true), 30.0);
+  const auto [pair_without, end_without] =
+      errors(run_rendered(Motion::kWalk, 40, 30.0, true, 5, epipolar, true), 30.0);
+  EXPECT_LT(pair_with, 0.8 * pair_without);
+  EXPECT_LT(end_with, end_without);
+  RecordProperty("pair_direction_error_deg", std::to_string(pair_with) + " (" +
+                                                 std::to_string(pair_without) + " epipolar)");
+  RecordProperty("end_error_m", std::to_string(end_with) + " (" + std::to_string(end_without) + ")");
 }
 
 // A photograph: grey blocks of every size and brightness, with their edges in a few directions.

@@ -279,6 +279,32 @@ void VisualOdometry::fit_scale(Frame& f) {
   r.motion_covariance = metric_motion_covariance(unit, pose.t, scale, scale_sigma);
   r.motion_covariance.topLeftCorner<3, 3>() += f.oriented.motion_rotation_extra;
   r.motion_covariance_valid = true;
+  if (f.stereo) prefer_stereo_translation(f);
+}
+
+void VisualOdometry::prefer_stereo_translation(Frame& f) {
+  if (!(options_.stereo_translation_margin > 0.0)) return;
+  VisualOdometryResult& r = f.result;
+  const auto start = std::chrono::steady_clock::now();
+  const StereoRig rig{f.input.camera.pinhole.fx, f.input.camera.pinhole.fy, f.input.baseline_m};
+  StereoScaleOptions options = options_.stereo_scale;
+  options.disparity_offset_px = r.disparity_offset_px;
+  // Its points share their errors as the direction's do: as many independent ones. The rotation
+  // is refined with it (held, the translation takes in the rotation's error) but stays the pair's.
+  const StereoMotionEstimate m =
+      estimate_stereo_motion(r.motion.R, rig, r.scale_observations, options,
+                             pair_options().covariance.independent_translation_points);
+  r.stages.scale_ms += ms_since(start);
+  const Eigen::Matrix3d C = m.covariance.bottomRightCorner<3, 3>();
+  if (!m.ok || !all_finite(m.t) || !all_finite(C) ||
+      !(options_.stereo_translation_margin * C.trace() <
+        r.motion_covariance.bottomRightCorner<3, 3>().trace()))
+    return;
+  r.motion.t = m.t;
+  r.motion_covariance.bottomRightCorner<3, 3>() = C;
+  r.motion_covariance.topRightCorner<3, 3>().setZero();
+  r.motion_covariance.bottomLeftCorner<3, 3>().setZero();
+  r.scale_known = true;
 }
 
 }  // namespace hybrid_vo

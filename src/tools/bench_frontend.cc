@@ -45,7 +45,8 @@ void usage(const char* program) {
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
-               " [--no-rotation-only] [--rotation-keyframe-overlap F] [--verbose]\n"
+               " [--no-rotation-only] [--rotation-keyframe-overlap F]\n"
+               "       [--stereo-translation-margin M] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
@@ -77,10 +78,12 @@ void usage(const char* program) {
                "  --redetect-alternate: KLT re-detection in half the cells per frame, taking\n"
                "  turns (klt_redetect_alternate: true).\n"
                "  --rotation-calibration-sigma S: the node's rotation_calibration_sigma (how far\n"
-               "  every rotation may be off as a share of its angle; config/kitti.yaml: 0.01).\n"
+               "  every rotation may be off as a share of its angle; config/kitti.yaml: 0).\n"
                "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
                "  (rotation_only_pairs: false); --rotation-keyframe-overlap F: the node's\n"
-               "  rotation_keyframe_overlap.\n";
+               "  rotation_keyframe_overlap. --stereo-translation-margin M: a stereo pair takes\n"
+               "  the stereo points' translation where its covariance is M times smaller (0:\n"
+               "  never; default 2).\n";
 }
 
 // The median of each coordinate.
@@ -236,6 +239,8 @@ int run(int argc, char** argv) {
       o.rotation_only_pairs = false;
     else if (a == "--rotation-keyframe-overlap" && i + 1 < argc)
       o.rotation_keyframe_overlap = std::atof(argv[++i]);
+    else if (a == "--stereo-translation-margin" && i + 1 < argc)
+      o.stereo_translation_margin = std::atof(argv[++i]);
     else {
       usage(argv[0]);
       return 2;
