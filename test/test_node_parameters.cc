@@ -92,6 +92,8 @@ std::vector<Case> every_parameter() {
       {"klt_redetect_alternate", true, [](P p) { return p.odometry.klt.redetect_alternate; }},
       {"klt_min_corner_gradient", 1.5,
        [](P p) { return p.odometry.klt.min_corner_gradient == 1.5; }},
+      {"klt_min_corner_isotropy", 0.3,
+       [](P p) { return p.odometry.klt.min_corner_isotropy == 0.3; }},
       {"point_threshold_px", 2.0,
        [](P p) { return p.odometry.estimator.ransac.point_threshold_px == 2.0; }},
       {"vp_threshold_deg", 3.0,

@@ -489,6 +489,55 @@ bool same_tracker(const KltTracker& a, const KltTracker& b) {
 // redetect_alternate (the CPU budget's first level): after the first frame, which fills every
 // cell, each re-detection looks in one colour of a checkerboard of the grid's cells, the other
 // colour the next time; and a reset starts with every cell again.
+// Long straight bands on the left (edges without a corner: a point on them slides along), small
+// squares on the right (corners). Every corner passes the isotropy test; of the points on the
+// bands, goodFeaturesToTrack admits many where nothing stronger is near, the test none.
+TEST(KltTracker, IsotropyLeavesOutPointsOnStraightEdges) {
+  cv::Mat image(480, 640, CV_8UC1, cv::Scalar(40));
+  const Eigen::Vector2d along = Eigen::Vector2d(200.0, 580.0).normalized();
+  std::vector<Eigen::Vector2d> starts;
+  for (int k = 0; k < 6; ++k) {
+    starts.emplace_back(-150.0 + 45.0 * k, -50.0);
+    const Eigen::Vector2d end = starts.back() + 620.0 * along;
+    cv::line(image, cv::Point(starts.back().x(), starts.back().y()), cv::Point(end.x(), end.y()),
+             cv::Scalar(200), 3, cv::LINE_AA);
+  }
+  for (int y = 40; y < 440; y += 50)
+    for (int x = 400; x < 620; x += 50)
+      cv::rectangle(image, cv::Rect(x, y, 18, 18), cv::Scalar(190), cv::FILLED);
+  cv::Mat noise(image.size(), CV_8UC1);
+  cv::randn(noise, 0, 2);
+  image += noise;
+  cv::GaussianBlur(image, image, cv::Size(3, 3), 0.8);
+  auto on_a_band = [&](const cv::Point2f& p) {
+    for (const Eigen::Vector2d& a : starts) {
+      const Eigen::Vector2d q = Eigen::Vector2d(p.x, p.y) - a;
+      if (std::abs(q.x() * along.y() - q.y() * along.x()) < 5.0) return true;
+    }
+    return false;
+  };
+  auto count = [&](double isotropy, int* corners) {
+    KltTrackerOptions options;
+    options.min_corner_isotropy = isotropy;
+    KltTracker tracker(options, 600);
+    tracker.track(image);
+    int edge = 0;
+    *corners = 0;
+    for (const cv::Point2f& p : tracker.points()) {
+      edge += on_a_band(p) && p.x < 380.0f;
+      *corners += p.x > 390.0f;
+    }
+    return edge;
+  };
+  int corners_all = 0, corners_isotropic = 0;
+  const int edge_all = count(0.0, &corners_all);
+  const int edge_isotropic = count(0.3, &corners_isotropic);
+  EXPECT_GT(edge_all, 20);
+  EXPECT_EQ(edge_isotropic, 0);
+  EXPECT_GE(corners_isotropic, corners_all * 9 / 10);
+  EXPECT_GT(corners_isotropic, 60);  // four corners of most of the 40 squares
+}
+
 TEST(KltTracker, AlternateRedetectionFillsHalfTheCellsByTurns) {
   const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1000, 2.5);
   auto frame = [&](int k) {  // a pan: features leave on one side, cells empty on the other

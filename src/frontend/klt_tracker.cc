@@ -34,11 +34,17 @@ void search(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>
 
 // The weaker eigenvalue of the structure tensor of `gray` over a window x window square at p, as
 // an RMS gradient (Sobel / 8: grey levels per pixel); 0 where the window leaves the image.
-double corner_gradient(const cv::Mat& gray, const cv::Point2f& p, int window) {
+// The structure tensor of the tracking window around p, as RMS gradients (grey levels per
+// pixel) along its weaker and its stronger direction; zeros at the border.
+struct CornerStrength {
+  double weaker = 0.0, stronger = 0.0;
+};
+
+CornerStrength corner_strength(const cv::Mat& gray, const cv::Point2f& p, int window) {
   const int r = window / 2 + 1;  // one more pixel for the derivative's support
   const cv::Rect box(static_cast<int>(std::lround(p.x)) - r, static_cast<int>(std::lround(p.y)) - r,
                      2 * r + 1, 2 * r + 1);
-  if ((box & cv::Rect(0, 0, gray.cols, gray.rows)) != box) return 0.0;
+  if ((box & cv::Rect(0, 0, gray.cols, gray.rows)) != box) return {};
   cv::Mat gx, gy;
   cv::Sobel(gray(box), gx, CV_32F, 1, 0, 3, 0.125);
   cv::Sobel(gray(box), gy, CV_32F, 0, 1, 3, 0.125);
@@ -52,8 +58,9 @@ double corner_gradient(const cv::Mat& gray, const cv::Point2f& p, int window) {
     }
   const double n = (box.width - 2.0) * (box.height - 2.0);
   const double half_trace = 0.5 * (xx + yy), det = xx * yy - xy * xy;
-  const double weaker = half_trace - std::sqrt(std::max(0.0, half_trace * half_trace - det));
-  return std::sqrt(std::max(0.0, weaker) / n);
+  const double root = std::sqrt(std::max(0.0, half_trace * half_trace - det));
+  return {std::sqrt(std::max(0.0, half_trace - root) / n),
+          std::sqrt(std::max(0.0, half_trace + root) / n)};
 }
 
 }  // namespace
@@ -304,8 +311,11 @@ void KltTracker::detect_cell(KltDetection* d, int c) const {
   d->strong[c].assign(corners.size(), 1);
   for (size_t k = 0; k < corners.size(); ++k) {
     corners[k] += cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y));
-    if (options_.min_corner_gradient > 0.0 &&
-        corner_gradient(gray, corners[k], options_.window_px) < options_.min_corner_gradient)
+    if (!(options_.min_corner_gradient > 0.0) && !(options_.min_corner_isotropy > 0.0)) continue;
+    const CornerStrength strength = corner_strength(gray, corners[k], options_.window_px);
+    // Zeros: the window leaves the image (a band meeting the border looks like a corner).
+    if (!(strength.stronger > 0.0) || strength.weaker < options_.min_corner_gradient ||
+        strength.weaker < options_.min_corner_isotropy * strength.stronger)
       d->strong[c][k] = 0;
   }
 }

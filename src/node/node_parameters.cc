@@ -140,6 +140,8 @@ const std::vector<Parameter>& parameters() {
       field<bool>("klt_redetect_alternate", NODE_FIELD(bool, odometry.klt.redetect_alternate)),
       field<double>("klt_min_corner_gradient",
                     NODE_FIELD(double, odometry.klt.min_corner_gradient)),
+      field<double>("klt_min_corner_isotropy",
+                    NODE_FIELD(double, odometry.klt.min_corner_isotropy)),
       field<double>("point_threshold_px",
                     NODE_FIELD(double, odometry.estimator.ransac.point_threshold_px)),
       field<double>("vp_threshold_deg",

@@ -41,6 +41,7 @@ void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
+               " [--min-corner-isotropy R]"
                " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
@@ -51,7 +52,9 @@ void usage(const char* program) {
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
-               "  the KLT corners' strength floor (0: every corner); --drop-leaving: KLT drops\n"
+               "  the KLT corners' strength floor (0: every corner); --min-corner-isotropy R: a\n"
+               "  corner's weaker gradient at least R times its stronger (klt_min_corner_isotropy);\n"
+               "  --drop-leaving: KLT drops\n"
                "  the features predicted outside the image unsearched; --no-anchor: no orientation\n"
                "  correction by the map of directions; --no-direction-map (old name:\n"
                "  --no-vp-tracker): no map of directions at all. Default preset hybrid+junc.\n"
@@ -181,6 +184,8 @@ int run(int argc, char** argv) {
     else if (a == "--lbd") o.track_lines = false;
     else if (a == "--min-corner-gradient" && i + 1 < argc)
       o.klt.min_corner_gradient = std::atof(argv[++i]);
+    else if (a == "--min-corner-isotropy" && i + 1 < argc)
+      o.klt.min_corner_isotropy = std::atof(argv[++i]);
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--drop-leaving") o.klt.drop_leaving = true;
     else if (a == "--redetect-alternate") o.klt.redetect_alternate = true;

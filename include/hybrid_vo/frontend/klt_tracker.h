@@ -25,6 +25,12 @@ struct KltTrackerOptions {
   // KITTI's corners: 1.4 and up at the 10th percentile). 0 keeps every corner: the rendered
   // corridor's low-contrast texture needs its weak corners (drift 1.7 -> 25 deg/100 m at 1.5).
   double min_corner_gradient = 0.0;
+  // A point on a straight edge slides along it: KLT follows it across the edge only, and the
+  // pose takes the slide (TartanAir's white panels: 20 pairs 0.4-0.7 degrees off each, claiming
+  // 0.02). goodFeaturesToTrack admits such points where a cell's strongest corner is far
+  // stronger. A corner is kept only when its weaker RMS gradient is at least this share of its
+  // stronger one (an edge: near 0; a corner: up to 1). 0 keeps every corner.
+  double min_corner_isotropy = 0.0;
   // Lucas-Kanade's cost grows with the window's area: 11 px costs about a quarter of 21 px, and
   // through the odometry it is as accurate or better on KITTI 01 (AUC@10 95.96 against 95.83)
   // and the rendered corridor (ATE 0.0104 against 0.0176 m) (doc/vanishing_points.md).
@@ -79,8 +85,8 @@ template <typename Visit>
 void visit_fields(KltTrackerOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(positive(), o.grid_cols, o.grid_rows, o.max_forward_backward_px,
                   o.max_iterations);
-  HYBRID_VO_FIELDS(non_negative(), o.min_distance_px, o.min_corner_gradient, o.pyramid_levels,
-                  o.predicted_pyramid_levels);
+  HYBRID_VO_FIELDS(non_negative(), o.min_distance_px, o.min_corner_gradient,
+                  o.min_corner_isotropy, o.pyramid_levels, o.predicted_pyramid_levels);
   HYBRID_VO_FIELDS(fraction(), o.redetect_min_missing);
   HYBRID_VO_FIELDS(positive_fraction(), o.quality_level);
   HYBRID_VO_FIELDS(at_least(5), o.window_px);  // smaller windows lose the texture
