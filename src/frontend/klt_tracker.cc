@@ -32,10 +32,9 @@ void search(const std::vector<cv::Mat>& from_pyramid, const std::vector<cv::Mat>
                       found);
 }
 
-// The weaker eigenvalue of the structure tensor of `gray` over a window x window square at p, as
-// an RMS gradient (Sobel / 8: grey levels per pixel); 0 where the window leaves the image.
-// The structure tensor of the tracking window around p, as RMS gradients (grey levels per
-// pixel) along its weaker and its stronger direction; zeros at the border.
+// The structure tensor of `gray` over a window x window square at p, as RMS gradients (Sobel /
+// 8: grey levels per pixel) along its weaker and its stronger direction; zeros where the window
+// leaves the image.
 struct CornerStrength {
   double weaker = 0.0, stronger = 0.0;
 };
