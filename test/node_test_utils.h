@@ -116,6 +116,10 @@ class NodeHarness {
     }
   }
 
+  // Spins until the odometry status's `key` reaches at least `value` (diagnostics come about once
+  // a second, after the frame that changed them).
+  bool wait_for_diagnostic(const std::string& key, double value, double seconds = 5.0);
+
   void on_motion(const MotionEstimate::ConstPtr& m) {
     motions_[m->header.stamp] = *m;
     received_.push_back(*m);
@@ -170,6 +174,16 @@ inline double diagnostic_value(const diagnostic_msgs::DiagnosticStatus& s, const
   for (const auto& kv : s.values)
     if (kv.key == key) return std::atof(kv.value.c_str());
   return -1.0;
+}
+
+inline bool NodeHarness::wait_for_diagnostic(const std::string& key, double value, double seconds) {
+  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < end) {
+    ros::spinOnce();
+    if (diagnostic_value(last_odometry_status_, key) >= value) return true;
+    ros::WallDuration(0.01).sleep();
+  }
+  return false;
 }
 
 }  // namespace testing
