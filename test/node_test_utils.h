@@ -72,6 +72,13 @@ inline sensor_msgs::Image image_of(const cv::Mat& gray, const ros::Time& stamp, 
   return m;
 }
 
+// A diagnostic status's value of `key` as a number; -1 when it has none.
+inline double diagnostic_value(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {
+  for (const auto& kv : s.values)
+    if (kv.key == key) return std::atof(kv.value.c_str());
+  return -1.0;
+}
+
 // Publishes frames and waits for the node's answer to each, so that no frame is dropped.
 class NodeHarness {
  public:
@@ -97,28 +104,33 @@ class NodeHarness {
     return wait_connected(inputs, {motion_sub_, diagnostics_sub_, vps_sub_, odometry_sub_});
   }
 
-  // Waits for the ~relative_pose message of `stamp`.
-  bool wait_for(const ros::Time& stamp, double seconds = 20.0) {
+  // Spins until `done()` or for `seconds` (wall time); whether it was done.
+  template <class Done>
+  bool spin_until(Done done, double seconds) {
     const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
     while (ros::ok() && ros::WallTime::now() < end) {
       ros::spinOnce();
-      if (motions_.count(stamp)) return true;
+      if (done()) return true;
       ros::WallDuration(0.005).sleep();
     }
     return false;
   }
 
+  // Waits for the ~relative_pose message of `stamp`.
+  bool wait_for(const ros::Time& stamp, double seconds = 20.0) {
+    return spin_until([&] { return motions_.count(stamp) > 0; }, seconds);
+  }
+
   void spin_for(double seconds) {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-    while (ros::ok() && ros::WallTime::now() < end) {
-      ros::spinOnce();
-      ros::WallDuration(0.01).sleep();
-    }
+    spin_until([] { return false; }, seconds);
   }
 
   // Spins until the odometry status's `key` reaches at least `value` (diagnostics come about once
   // a second, after the frame that changed them).
-  bool wait_for_diagnostic(const std::string& key, double value, double seconds = 5.0);
+  bool wait_for_diagnostic(const std::string& key, double value, double seconds = 5.0) {
+    return spin_until([&] { return diagnostic_value(last_odometry_status_, key) >= value; },
+                      seconds);
+  }
 
   void on_motion(const MotionEstimate::ConstPtr& m) {
     motions_[m->header.stamp] = *m;
@@ -168,22 +180,6 @@ inline Eigen::Matrix<double, 6, 6> covariance_of(const boost::array<double, 36>&
 }
 inline bool unknown(const boost::array<double, 36>& a) {
   return covariance_of(a) == 9999.0 * Eigen::Matrix<double, 6, 6>::Identity();
-}
-
-inline double diagnostic_value(const diagnostic_msgs::DiagnosticStatus& s, const std::string& key) {
-  for (const auto& kv : s.values)
-    if (kv.key == key) return std::atof(kv.value.c_str());
-  return -1.0;
-}
-
-inline bool NodeHarness::wait_for_diagnostic(const std::string& key, double value, double seconds) {
-  const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < end) {
-    ros::spinOnce();
-    if (diagnostic_value(last_odometry_status_, key) >= value) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return false;
 }
 
 }  // namespace testing
