@@ -11,7 +11,7 @@
 
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/rotation.h"
-#include "hybrid_vo/lines/direction_map.h"
+#include "hybrid_vo/direction_map/direction_map.h"
 
 namespace hybrid_vo {
 namespace {

@@ -12,8 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "hybrid_vo/geometry/rotation.h"
-#include "hybrid_vo/lines/joint_orientation.h"
-#include "hybrid_vo/lines/orientation_filter.h"
+#include "hybrid_vo/direction_map/joint_orientation.h"
+#include "hybrid_vo/direction_map/orientation_filter.h"
 
 namespace hybrid_vo {
 namespace {

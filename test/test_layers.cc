@@ -1,7 +1,8 @@
 // Which folder may include which, checked on the sources themselves (doc/development.md, Layout).
-//   - The core (geometry, solvers, estimation, lines, synthetic) links Eigen and Ceres only, and
-//     each layer includes only the layers before it (DESIGN.md: geometry <- solvers <- estimation
-//     <- lines <- frontend <- node); synthetic data may use all of the core.
+//   - The core (geometry, solvers, estimation, lines, direction_map, synthetic) links Eigen and
+//     Ceres only, and each layer includes only the layers before it (DESIGN.md: geometry <-
+//     solvers <- estimation <- lines <- direction_map <- frontend <- node); synthetic data may use
+//     all of the core.
 //   - datasets, render and evaluation may use the core, the front end and OpenCV; conversion may
 //     also use datasets, render (the bag's camera frames are the renderer's) and ROS (rosbag and
 //     messages). Nothing in the core, the front end or the node uses any of the four.
@@ -43,7 +44,8 @@ std::set<std::string> operator+(std::set<std::string> a, const std::set<std::str
   return a;
 }
 
-const std::set<std::string> kCore = {"geometry", "solvers", "estimation", "lines", "synthetic"};
+const std::set<std::string> kCore = {"geometry", "solvers",       "estimation",
+                                      "lines",    "direction_map", "synthetic"};
 const std::set<std::string> kOpenCvLibrary = kCore + std::set<std::string>{"frontend", "opencv"};
 
 // Per folder (under src/ and include/hybrid_vo/ alike), what its files may include.
@@ -52,6 +54,7 @@ const std::map<std::string, std::set<std::string>> kRules = {
     {"solvers", {"geometry", "solvers"}},
     {"estimation", {"geometry", "solvers", "estimation"}},
     {"lines", {"geometry", "solvers", "estimation", "lines"}},
+    {"direction_map", {"geometry", "solvers", "estimation", "lines", "direction_map"}},
     {"synthetic", kCore},
     {"frontend", kOpenCvLibrary},
     {"node", kOpenCvLibrary + std::set<std::string>{"node", "messages", "ros"}},

@@ -11,7 +11,7 @@
 
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/geometry/rotation.h"
-#include "hybrid_vo/lines/orientation_filter.h"
+#include "hybrid_vo/direction_map/orientation_filter.h"
 
 namespace hybrid_vo {
 namespace {

@@ -76,7 +76,7 @@ struct VisualOdometryOptions {
   // which shortens the scale (affine_tracking.h). The pose keeps the tracker's points.
   bool stereo_refine_tracks = true;
   AffineTrackingOptions stereo_track_refinement;
-  // The map of world directions (lines/direction_map.h): the pairs' VPs kept as landmarks in the
+  // The map of world directions (direction_map/direction_map.h): the pairs' VPs kept as landmarks in the
   // odometry frame, priors for the next pair's VPs, and (anchor_orientation) the absolute
   // reference that corrects each frame's orientation, predicted by the pair's rotation, wherever
   // the camera sees its directions; found again by their structure after a blank wall. Each

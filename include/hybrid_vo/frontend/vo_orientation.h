@@ -7,7 +7,7 @@
 #include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
 #include "hybrid_vo/geometry/camera.h"
-#include "hybrid_vo/lines/orientation_filter.h"
+#include "hybrid_vo/direction_map/orientation_filter.h"
 
 namespace hybrid_vo {
 

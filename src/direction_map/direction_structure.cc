@@ -1,4 +1,4 @@
-#include "hybrid_vo/lines/direction_structure.h"
+#include "hybrid_vo/direction_map/direction_structure.h"
 
 #include <algorithm>
 #include <cmath>

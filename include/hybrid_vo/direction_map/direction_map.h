@@ -12,9 +12,9 @@
 
 #include "hybrid_vo/estimation/matches.h"
 #include "hybrid_vo/geometry/option_fields.h"
-#include "hybrid_vo/lines/direction_association.h"
-#include "hybrid_vo/lines/direction_structure.h"
-#include "hybrid_vo/lines/joint_orientation.h"
+#include "hybrid_vo/direction_map/direction_association.h"
+#include "hybrid_vo/direction_map/direction_structure.h"
+#include "hybrid_vo/direction_map/joint_orientation.h"
 
 namespace hybrid_vo {
 

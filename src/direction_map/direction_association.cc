@@ -1,4 +1,4 @@
-#include "hybrid_vo/lines/direction_association.h"
+#include "hybrid_vo/direction_map/direction_association.h"
 
 #include <algorithm>
 #include <cmath>

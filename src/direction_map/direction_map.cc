@@ -1,4 +1,4 @@
-#include "hybrid_vo/lines/direction_map.h"
+#include "hybrid_vo/direction_map/direction_map.h"
 
 #include <algorithm>
 #include <cmath>

@@ -14,7 +14,7 @@
 #include "hybrid_vo/estimation/translation_given_rotation.h"
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/geometry/option_fields.h"
-#include "hybrid_vo/lines/direction_map.h"
+#include "hybrid_vo/direction_map/direction_map.h"
 
 namespace hybrid_vo {
 

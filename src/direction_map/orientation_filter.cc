@@ -1,4 +1,4 @@
-#include "hybrid_vo/lines/orientation_filter.h"
+#include "hybrid_vo/direction_map/orientation_filter.h"
 
 #include <cmath>
 

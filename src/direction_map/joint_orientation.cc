@@ -1,4 +1,4 @@
-#include "hybrid_vo/lines/joint_orientation.h"
+#include "hybrid_vo/direction_map/joint_orientation.h"
 
 #include <algorithm>
 #include <cmath>
