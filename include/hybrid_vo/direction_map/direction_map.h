@@ -56,11 +56,14 @@ struct DirectionMapOptions {
   // by a small angle could have found.
   double reacquisition_deg = 3.0;
   // ... and needs two paired directions at least this far apart (degrees). Where the
-  // orientation's own covariance pairs fewer than wide_reacquisition_pairs, that many are also
+  // orientation's own covariance pairs fewer than wide_reacquisition_pairs, that many may also be
   // sought under this much more uncertainty (degrees, per axis), for a correction of at most as
-  // much: a wrong pair can be surer of itself than it should.
+  // much. Off (0) by default: a correction is then at most what the chain of pairs since the
+  // directions were seen allows by its covariance. The 5 degrees once rescued TartanAir's sure and
+  // wrong pairs, but on streets, whose facades lie a few degrees apart, it re-acquired the wrong
+  // direction by 4-5 degrees in one frame (doc/consistency.md).
   double reacquisition_min_angle_deg = 30.0;
-  double reacquisition_sigma_deg = 5.0;
+  double reacquisition_sigma_deg = 0.0;
   int wide_reacquisition_pairs = 3;
   DirectionAssociationOptions association;
   DirectionStructureOptions structure;
