@@ -69,8 +69,10 @@ def test_every_topic_echoes_and_has_a_rate(node_with_frames):
         out = echo(topic, env)
         assert "---" in out, f"rostopic echo -n 1 {topic} printed no message:\n{out[-2000:]}"
         assert "Cannot load message class" not in out, out[-2000:]
-    # All at once: each for 8 s, long enough for two messages of the 1 Hz /diagnostics.
-    rates = {topic: start(f"source {SETUP} && exec timeout -s INT 8 rostopic hz {topic}", env,
+    # All at once, each for 20 s: fifteen rospy processes starting together take several seconds
+    # of a 2-core machine before they subscribe (8 s once left ~debug_image without a rate in CI),
+    # and the 1 Hz /diagnostics needs two messages after that.
+    rates = {topic: start(f"source {SETUP} && exec timeout -s INT 20 rostopic hz {topic}", env,
                           ROOT) for topic in TOPICS}
     for topic, process in rates.items():
         process.wait(timeout=60)
