@@ -418,6 +418,7 @@ TEST_F(VideoFrontEnd, StereoScalePointsDoNotLagOnApproachingSurfaces) {
   // -0.005).
   VisualOdometryOptions defaults;
   defaults.klt.min_corner_gradient = 0.0;
+  defaults.klt.strongest_first = false;  // which would leave the weak ones for last
   VisualOdometryOptions klt_points = defaults;
   klt_points.stereo_refine_tracks = false;
   klt_points.stereo_scale.point_sigma_px = 0.5;  // the weight the KLT's points had
@@ -516,9 +517,12 @@ TEST(KltTracker, IsotropyLeavesOutPointsOnStraightEdges) {
     }
     return false;
   };
-  auto count = [&](double isotropy, int* corners) {
+  // The weak-corner rule left out (weak_corner_gradient 0): it too keeps edges out while there
+  // are corners enough, and would hide what the isotropy does.
+  auto count = [&](double isotropy, int* corners, double weak_gradient = 0.0) {
     KltTrackerOptions options;
     options.min_corner_isotropy = isotropy;
+    options.weak_corner_gradient = weak_gradient;
     KltTracker tracker(options, 600);
     tracker.track(image);
     int edge = 0;
@@ -536,6 +540,11 @@ TEST(KltTracker, IsotropyLeavesOutPointsOnStraightEdges) {
   EXPECT_EQ(edge_isotropic, 0);
   EXPECT_GE(corners_isotropic, corners_all * 9 / 10);
   EXPECT_GT(corners_isotropic, 60);  // four corners of most of the 40 squares
+  // The default's weak-corner rule: an edge's weaker gradient is noise, so its points wait until
+  // the tracker runs short of corners, which 160 corners spare it here.
+  int corners_default = 0;
+  EXPECT_LE(count(0.0, &corners_default, KltTrackerOptions().weak_corner_gradient), edge_all / 4);
+  EXPECT_GE(corners_default, corners_all * 9 / 10);
 }
 
 TEST(KltTracker, AlternateRedetectionFillsHalfTheCellsByTurns) {

@@ -58,8 +58,9 @@ class ScaleModel {
   bool rows(const State& x, double rho, const StereoScaleObservation& o, PointRows* p) const {
     p->rows = 0;
     Vector7d j = Vector7d::Zero();
-    j(kDelta) = 1.0 / sd_;
-    add(p, (c_ * rho + x.delta - o.disparity_ref) / sd_, c_ / sd_, j);
+    const double sd_ref = o.disparity_ref_sigma_px > 0.0 ? o.disparity_ref_sigma_px : sd_;
+    j(kDelta) = 1.0 / sd_ref;
+    add(p, (c_ * rho + x.delta - o.disparity_ref) / sd_ref, c_ / sd_ref, j);
 
     const Eigen::Vector3d Rn = x.R * homogeneous(o.x_ref);
     const Eigen::Vector3d P = Rn + x.s * rho * x.t;  // the current point times rho

@@ -79,11 +79,21 @@ void KltTracker::reset() {
   points_.clear();
   motion_.clear();
   ids_.clear();
+  age_.clear();
   stamp_ = motion_dt_ = kNoStamp;
   detections_ = 0;
 }
 
 int KltTracker::num_tracks() const { return static_cast<int>(points_.size()); }
+
+int KltTrackStats::median_lifetime() const {
+  int64_t seen = 0;
+  for (size_t k = 0; k < lifetimes.size(); ++k) {
+    seen += lifetimes[k];
+    if (lost > 0 && 2 * seen >= lost) return static_cast<int>(k);
+  }
+  return lost > 0 ? static_cast<int>(lifetimes.size()) : 0;
+}
 
 double KltTracker::motion_scale(double stamp) const {
   const double dt = stamp - stamp_;
@@ -216,12 +226,25 @@ std::vector<PointMatch> KltTracker::track_existing(const GrayImage& image,
 
     std::vector<cv::Point2f> kept, kept_motion;
     std::vector<int64_t> kept_ids;
+    std::vector<int> kept_age;
     const double max_fb_sq = options_.max_forward_backward_px * options_.max_forward_backward_px;
+    ++stats_.frames;
+    stats_.searched += n;
+    if (stats_.lifetimes.empty()) stats_.lifetimes.assign(64, 0);
+    const auto lose = [&](int age) {
+      ++stats_.lost;
+      stats_.lost_at_first += age == 0;
+      stats_.lifetime_sum += age;
+      ++stats_.lifetimes[std::min<size_t>(age, stats_.lifetimes.size() - 1)];
+    };
     for (int i = 0; i < n; ++i) {
+      const int age = i < static_cast<int>(age_.size()) ? age_[i] : 0;
       // Found outside the image: never searched back (search_range).
-      if (!s.found[i] || !s.back_found[i]) continue;
       const cv::Point2f d = s.back[i] - points_[i];
-      if (d.dot(d) > max_fb_sq) continue;
+      if (!s.found[i] || !s.back_found[i] || d.dot(d) > max_fb_sq) {
+        lose(age);
+        continue;
+      }
       PointMatch m;
       m.x1 = Eigen::Vector2d(points_[i].x, points_[i].y);
       m.x2 = Eigen::Vector2d(s.next[i].x, s.next[i].y);
@@ -230,10 +253,12 @@ std::vector<PointMatch> KltTracker::track_existing(const GrayImage& image,
       kept.push_back(s.next[i]);
       kept_motion.push_back(s.next[i] - points_[i]);
       kept_ids.push_back(ids_[i]);
+      kept_age.push_back(age + 1);
     }
     points_ = std::move(kept);
     motion_ = std::move(kept_motion);
     ids_ = std::move(kept_ids);
+    age_ = std::move(kept_age);
   }
   // The motions just measured span this time step (NaN without stamps).
   motion_dt_ = stamp - stamp_;
@@ -283,14 +308,18 @@ KltDetection KltTracker::plan_detection() const {
   d.wanted.resize(d.cells());
   const int min_missing = static_cast<int>(std::ceil(options_.redetect_min_missing * quota));
   const bool alternate = options_.redetect_alternate && !points_.empty();
+  // Enough tracks: no re-detection at all this frame.
+  const bool enough = !points_.empty() &&
+                      points_.size() >= options_.refill_below * max_features;
   for (int c = 0; c < d.cells(); ++c) {
-    d.wanted[c] = quota - count[c];
+    d.wanted[c] = enough ? 0 : quota - count[c];
     if (d.wanted[c] < min_missing) d.wanted[c] = 0;
     const int cx = c % cols, cy = c / cols;
     if (alternate && (cx + cy + detections_) % 2 != 0) d.wanted[c] = 0;
   }
   d.corners.resize(d.cells());
   d.strong.resize(d.cells());
+  d.strength.resize(d.cells());
   return d;
 }
 
@@ -304,14 +333,21 @@ void KltTracker::detect_cell(KltDetection* d, int c) const {
   // All the cell may want: add_detections takes fewer when max_features leaves less room, and
   // goodFeaturesToTrack's first k corners are the same whatever the maximum (it admits them
   // strongest first and stops at the maximum).
+  // Strongest first: twice the cell's want, so that its stronger corners compete with the other
+  // cells' for the image's share.
   std::vector<cv::Point2f>& corners = d->corners[c];
-  cv::goodFeaturesToTrack(gray(cell), corners, d->wanted[c], options_.quality_level,
+  const int candidates = options_.strongest_first ? 2 * d->wanted[c] : d->wanted[c];
+  cv::goodFeaturesToTrack(gray(cell), corners, candidates, options_.quality_level,
                           options_.min_distance_px, d->mask(cell));
   d->strong[c].assign(corners.size(), 1);
+  d->strength[c].assign(corners.size(), 0.0f);
   for (size_t k = 0; k < corners.size(); ++k) {
     corners[k] += cv::Point2f(static_cast<float>(cell.x), static_cast<float>(cell.y));
-    if (!(options_.min_corner_gradient > 0.0) && !(options_.min_corner_isotropy > 0.0)) continue;
+    if (!(options_.min_corner_gradient > 0.0) && !(options_.min_corner_isotropy > 0.0) &&
+        !options_.strongest_first)
+      continue;
     const CornerStrength strength = corner_strength(gray, corners[k], options_.window_px);
+    d->strength[c][k] = static_cast<float>(strength.weaker);
     // Zeros: the window leaves the image (a band meeting the border looks like a corner).
     if (!(strength.stronger > 0.0) || strength.weaker < options_.min_corner_gradient ||
         strength.weaker < options_.min_corner_isotropy * strength.stronger)
@@ -322,14 +358,51 @@ void KltTracker::detect_cell(KltDetection* d, int c) const {
 void KltTracker::add_detections(const KltDetection& d) {
   ++detections_;
   const int max_features = std::max(1, max_features_);
-  for (int c = 0; c < d.cells() && c < static_cast<int>(d.corners.size()); ++c) {
-    const int room = max_features - static_cast<int>(points_.size());
-    const int take = std::min({room, d.wanted[c], static_cast<int>(d.corners[c].size())});
-    for (int k = 0; k < take; ++k) {
-      if (!d.strong[c][k]) continue;
-      points_.push_back(d.corners[c][k]);
-      motion_.push_back(cv::Point2f(kUnknown, kUnknown));
-      ids_.push_back(next_id_++);
+  const auto add = [&](const cv::Point2f& p) {
+    points_.push_back(p);
+    motion_.push_back(cv::Point2f(kUnknown, kUnknown));
+    ids_.push_back(next_id_++);
+    age_.push_back(0);
+    ++stats_.detected;
+  };
+  const int cells = std::min(d.cells(), static_cast<int>(d.corners.size()));
+  if (options_.strongest_first) {
+    // Every cell's candidates, strongest first over the image; each cell up to its want. Two
+    // cells' candidates may lie closer than min_distance_px across their border: the later one
+    // gives way.
+    std::vector<std::pair<float, std::pair<int, int>>> order;
+    for (int c = 0; c < cells; ++c)
+      for (size_t k = 0; k < d.corners[c].size(); ++k)
+        if (d.strong[c][k]) order.push_back({d.strength[c][k], {c, static_cast<int>(k)}});
+    std::stable_sort(order.begin(), order.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<int> taken(cells, 0);
+    const size_t first_new = points_.size();
+    const float min_sq = static_cast<float>(options_.min_distance_px * options_.min_distance_px);
+    const int weak_room = static_cast<int>(options_.weak_corner_share * max_features);
+    for (const auto& [strength, at] : order) {
+      if (static_cast<int>(points_.size()) >= max_features) break;
+      if (strength < options_.weak_corner_gradient &&
+          static_cast<int>(points_.size()) >= weak_room)
+        break;
+      const auto [c, k] = at;
+      if (taken[c] >= d.wanted[c]) continue;
+      const cv::Point2f& p = d.corners[c][k];
+      bool crowded = false;
+      for (size_t j = first_new; j < points_.size() && !crowded; ++j) {
+        const cv::Point2f e = points_[j] - p;
+        crowded = e.dot(e) < min_sq;
+      }
+      if (crowded) continue;
+      add(p);
+      ++taken[c];
+    }
+  } else {
+    for (int c = 0; c < cells; ++c) {
+      const int room = max_features - static_cast<int>(points_.size());
+      const int take = std::min({room, d.wanted[c], static_cast<int>(d.corners[c].size())});
+      for (int k = 0; k < take; ++k)
+        if (d.strong[c][k]) add(d.corners[c][k]);
     }
   }
   // Tracks crowding into a few cells can still exceed the cap: keep the oldest (lowest ids).
@@ -342,14 +415,17 @@ void KltTracker::add_detections(const KltDetection& d) {
     std::sort(order.begin(), order.end());
     std::vector<cv::Point2f> kept, kept_motion;
     std::vector<int64_t> kept_ids;
+    std::vector<int> kept_age;
     for (size_t i : order) {
       kept.push_back(points_[i]);
       kept_motion.push_back(motion_[i]);
       kept_ids.push_back(ids_[i]);
+      kept_age.push_back(age_[i]);
     }
     points_ = std::move(kept);
     motion_ = std::move(kept_motion);
     ids_ = std::move(kept_ids);
+    age_ = std::move(kept_age);
   }
 }
 

@@ -69,6 +69,7 @@ void VisualOdometry::restart() {
   line_tracker_.reset();
   keyframe_ = Keyframe();
   last_answer_stamp_ = -1e300;
+  mono_speed_ = -1.0;
 }
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
@@ -116,7 +117,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   if (f.rotation_only || !f.baseline) measure_stereo_motion(f);
   orient(f);
   fit_scale(f);
-  if ((f.rotation_only || !f.baseline) && keeps_keyframe(f)) return answer_without_keyframe(f);
+  if (keeps_keyframe(f)) return answer_without_keyframe(f);
   integrate(f);
   return keep_as_keyframe(f);
 }
@@ -186,6 +187,8 @@ void VisualOdometry::integrate(Frame& f) {
   r.pose_covariance = pose_covariance_.covariance();
   r.pose_covariance_gaps = pose_covariance_.gaps();
   r.became_keyframe = true;
+  const double dt = f.input.stamp - keyframe_.stamp;
+  if (!f.stereo && r.baseline && dt > 0.0) mono_speed_ = r.motion.t.norm() / dt;
   if (f.rotation_only) return;
   r.status = VoStatus::kOk;
   if (r.message.empty()) r.message = "ok";

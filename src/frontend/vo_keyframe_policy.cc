@@ -1,11 +1,12 @@
 // VisualOdometry's keyframe policy: every frame is paired with the last keyframe. A frame becomes
-// the keyframe when its full pose is found over a baseline, and when a new chain starts at it (the
-// first frame, or too few matches to pair it). Where it moved too little off its rotation for a
-// baseline (min_parallax_px: the parallax after the rotation), or its points' noise explains what
-// the rotation leaves (model selection: then it is answered with its rotation alone), the
-// keyframe stays, so that the baseline grows, until the keyframe's points are leaving the view
-// (rotation_keyframe_overlap). Without rotation-only pairs such frames are left out, as any
-// frame whose pose is not found. Also what a keyframe keeps.
+// the keyframe when its parallax after the rotation reaches keyframe_parallax_px (a baseline
+// that fixes the translation), when the keyframe's points are leaving the view (keyframe_overlap,
+// keyframe_min_points), and when a new chain starts at it (the first frame, or too few matches to
+// pair it). Until then the keyframe stays, so that the baseline grows: frames with some parallax
+// are answered with their full pose against it, those that moved too little off their rotation
+// for a baseline (min_parallax_px), or whose points' noise explains what the rotation leaves
+// (model selection), with their rotation alone. Without rotation-only pairs such frames are left
+// out, as any frame whose pose is not found. Also what a keyframe keeps.
 #include <string>
 
 #include "vo_frame.h"
@@ -43,8 +44,11 @@ VisualOdometry::Pairing VisualOdometry::decide_keyframe(Frame& f) {
 }
 
 bool VisualOdometry::keeps_keyframe(const Frame& f) const {
-  return f.result.num_point_matches >=
-         options_.rotation_keyframe_overlap * std::max(0, keyframe_.paired_points);
+  const bool short_baseline = f.rotation_only || !f.baseline ||
+                              (f.parallax >= 0.0 && f.parallax < options_.keyframe_parallax_px);
+  const int seen = f.result.num_point_matches;
+  return short_baseline && seen >= options_.keyframe_min_points &&
+         seen >= options_.keyframe_overlap * std::max(0, keyframe_.paired_points);
 }
 
 VisualOdometryResult VisualOdometry::keep_as_keyframe(Frame& f) {
@@ -74,7 +78,9 @@ VisualOdometryResult VisualOdometry::skip_frame(Frame& f) {
 void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> points,
                                    std::vector<int64_t> pending) {
   const VisualOdometryInput& input = f.input;
+  std::map<int64_t, InverseDepth> depths = keyframe_depths(f);
   keyframe_ = Keyframe();
+  keyframe_.depths = std::move(depths);
   keyframe_.valid = true;
   keyframe_.stamp = input.stamp;
   keyframe_.points = std::move(points);

@@ -263,6 +263,10 @@ void VisualOdometry::fit_scale(Frame& f) {
       r.scale_known = true;
     }
     r.stages.scale_ms += ms_since(scale_start);
+  } else if (options_.mono_relative_scale) {
+    const double dt = f.input.stamp - keyframe_.stamp;
+    if (!fit_mono_scale(f, &scale, &scale_sigma) && mono_speed_ > 0.0 && dt > 0.0)
+      scale = mono_speed_ * dt;
   }
   r.motion.t = pose.t * scale;
   // Without the estimator's covariance the rotation gets a blank wall's (VoOrientation::orient)

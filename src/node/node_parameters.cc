@@ -128,8 +128,9 @@ const std::vector<Parameter>& parameters() {
       field<int>("max_features", NODE_FIELD(int, odometry.features.points.max_features)),
       field<double>("min_parallax_px", NODE_FIELD(double, odometry.min_parallax_px)),
       field<bool>("rotation_only_pairs", NODE_FIELD(bool, odometry.rotation_only_pairs)),
-      field<double>("rotation_keyframe_overlap",
-                    NODE_FIELD(double, odometry.rotation_keyframe_overlap)),
+      field<double>("keyframe_parallax_px", NODE_FIELD(double, odometry.keyframe_parallax_px)),
+      field<double>("keyframe_overlap", NODE_FIELD(double, odometry.keyframe_overlap)),
+      field<int>("keyframe_min_points", NODE_FIELD(int, odometry.keyframe_min_points)),
       field<bool>("track_lines", NODE_FIELD(bool, odometry.track_lines)),
       field<bool>("concurrent_frontend", NODE_FIELD(bool, odometry.concurrent)),
       field<double>("max_cpu_ms", NODE_FIELD(double, odometry.budget.max_cpu_ms)),
@@ -142,6 +143,14 @@ const std::vector<Parameter>& parameters() {
                     NODE_FIELD(double, odometry.klt.min_corner_gradient)),
       field<double>("klt_min_corner_isotropy",
                     NODE_FIELD(double, odometry.klt.min_corner_isotropy)),
+      // As bench_frontend's --seed: a run is repeatable, and results can be shown over seeds.
+      {"ransac_seed",
+       [](const XmlRpcValue& v, NodeParameters* p) {
+         int value = 0;
+         if (!read_value(v, &value) || value < 0) return std::string("expected an integer >= 0");
+         p->odometry.estimator.ransac.seed = static_cast<uint64_t>(value);
+         return std::string();
+       }},
       field<double>("point_threshold_px",
                     NODE_FIELD(double, odometry.estimator.ransac.point_threshold_px)),
       field<double>("vp_threshold_deg",
@@ -177,8 +186,10 @@ struct Renamed {
   std::string old_name, name;
 };
 const std::vector<Renamed>& renamed_parameters() {
-  // Issue 43: the VP tracker became the map of world directions.
-  static const std::vector<Renamed> table = {{"vp_tracker", "direction_map"}};
+  // Issue 43: the VP tracker became the map of world directions; issue 53: the keyframe's
+  // overlap rule holds for every frame that keeps it, not only for a rotation alone.
+  static const std::vector<Renamed> table = {{"vp_tracker", "direction_map"},
+                                             {"rotation_keyframe_overlap", "keyframe_overlap"}};
   return table;
 }
 

@@ -46,7 +46,7 @@ void usage(const char* program) {
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
-               " [--no-rotation-only] [--rotation-keyframe-overlap F]\n"
+               " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]\n"
                "       [--stereo-translation-margin M] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
@@ -84,7 +84,8 @@ void usage(const char* program) {
                "  every rotation may be off as a share of its angle; config/kitti.yaml: 0).\n"
                "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
                "  (rotation_only_pairs: false); --rotation-keyframe-overlap F: the node's\n"
-               "  rotation_keyframe_overlap. --stereo-translation-margin M: a stereo pair takes\n"
+               "  keyframe_overlap; --keyframe-parallax P: keyframe_parallax_px (0: every frame\n"
+               "  with a baseline becomes the keyframe). --stereo-translation-margin M: a stereo pair takes\n"
                "  the stereo points' translation where its covariance is M times smaller (0:\n"
                "  never; default 2).\n";
 }
@@ -189,6 +190,12 @@ int run(int argc, char** argv) {
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--drop-leaving") o.klt.drop_leaving = true;
     else if (a == "--redetect-alternate") o.klt.redetect_alternate = true;
+    else if (a == "--strongest-first") o.klt.strongest_first = true;
+    else if (a == "--weak-corner-gradient" && i + 1 < argc)
+      o.klt.weak_corner_gradient = std::atof(argv[++i]);
+    else if (a == "--weak-corner-share" && i + 1 < argc)
+      o.klt.weak_corner_share = std::atof(argv[++i]);
+    else if (a == "--refill-below" && i + 1 < argc) o.klt.refill_below = std::atof(argv[++i]);
     else if (a == "--max-cpu-ms" && i + 1 < argc) o.budget.max_cpu_ms = std::atof(argv[++i]);
     else if (a == "--work-level" && i + 1 < argc) o.budget.min_work_level = std::atoi(argv[++i]);
     else if (a == "--stereo") stereo = true;
@@ -204,6 +211,8 @@ int run(int argc, char** argv) {
       o.orientation.drift_floor_deg = std::atof(argv[++i]);
     else if (a == "--direction-floor" && i + 1 < argc)
       o.orientation.map.min_direction_sigma_deg = std::atof(argv[++i]);
+    else if (a == "--keyframe-parallax" && i + 1 < argc)
+      o.keyframe_parallax_px = std::atof(argv[++i]);
     else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
@@ -242,8 +251,8 @@ int run(int argc, char** argv) {
       o.rotation_calibration_sigma = std::atof(argv[++i]);
     else if (a == "--no-rotation-only")
       o.rotation_only_pairs = false;
-    else if (a == "--rotation-keyframe-overlap" && i + 1 < argc)
-      o.rotation_keyframe_overlap = std::atof(argv[++i]);
+    else if ((a == "--keyframe-overlap" || a == "--rotation-keyframe-overlap") && i + 1 < argc)
+      o.keyframe_overlap = std::atof(argv[++i]);
     else if (a == "--stereo-translation-margin" && i + 1 < argc)
       o.stereo_translation_margin = std::atof(argv[++i]);
     else {
@@ -336,6 +345,8 @@ int run(int argc, char** argv) {
       stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
+  // Keyframes, and the answered frames a second after the first and those of them with a baseline.
+  int keyframes = 1, late_answers = 0, late_baselines = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
   evaluation::DirectionSightings vp_sightings;  // the VP observations' NEES (2 dof)
   double farthest = 0.0;             // of the position from the first frame's
@@ -561,6 +572,11 @@ int run(int argc, char** argv) {
     ransac.push_back(r.stages.ransac_ms);
     stereo_ms.push_back(r.stages.stereo_ms);
     answered_frames += answered(r.status);
+    keyframes += r.became_keyframe;
+    if (answered(r.status) && input.stamp - stamps[0] >= 1.0) {
+      ++late_answers;
+      late_baselines += r.baseline;
+    }
     farthest = std::max(farthest, (r.centre - odometry.front().c).norm());
     rotation_only += r.status == VoStatus::kRotationOnly;
     if (r.status != VoStatus::kOk && r.status != VoStatus::kRotationOnly) continue;
@@ -595,6 +611,19 @@ int run(int argc, char** argv) {
               answered_frames, frames - 1,
               frames > 1 ? 100.0 * answered_frames / (frames - 1) : 0.0, rotation_only, farthest,
               stereo ? "m" : "per-pair units");
+  std::printf("# keyframes: %d of %d frames; after the first second %d of %d answered frames have "
+              "a baseline (%.1f %%)\n",
+              keyframes, frames, late_baselines, late_answers,
+              late_answers > 0 ? 100.0 * late_baselines / late_answers : 0.0);
+  {
+    const KltTrackStats& t = vo.point_track_stats();
+    const double per_frame = t.frames > 0 ? 1.0 / t.frames : 0.0;
+    std::printf("# tracks: %.0f searched and %.0f new per frame, %.1f %% of the ended tracks lost at "
+                "their first track, median lifetime %d frames (mean %.1f)\n",
+                t.searched * per_frame, t.detected * per_frame,
+                t.lost > 0 ? 100.0 * t.lost_at_first / t.lost : 0.0, t.median_lifetime(),
+                t.lost > 0 ? static_cast<double>(t.lifetime_sum) / t.lost : 0.0);
+  }
   // Starting to move (stereo, with a truth in the first camera's frame): where the camera went
   // from its start, once it is 5 cm or more away, against where it truly went, and its length.
   if (stereo && truth.size() == estimate.size() && !truth.empty()) {

@@ -28,6 +28,9 @@ struct StereoScaleObservation {
   double disparity_ref = 0.0;                       // keyframe disparity, pixels (> 0)
   Eigen::Vector2d x_cur = Eigen::Vector2d::Zero();  // current frame, left, normalised
   double disparity_cur = 0.0;                       // current disparity, pixels; <= 0: unknown
+  // The keyframe disparity's own noise (pixels); <= 0: the options' disparity_sigma_px. A
+  // monocular keyframe's depths come from a pair's triangulation, each as sure as its parallax.
+  double disparity_ref_sigma_px = 0.0;
 };
 
 struct StereoScaleOptions {

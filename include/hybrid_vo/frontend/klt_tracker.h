@@ -59,6 +59,23 @@ struct KltTrackerOptions {
   // A cell is re-detected only once it misses this fraction of its quota: finding one or two
   // corners costs goodFeaturesToTrack over the whole cell, and most new features die young.
   double redetect_min_missing = 0.0;
+  // Re-detection only once the tracks fall below this share of max_features: a frame that lost a
+  // few tracks needs no new ones, and refilling every frame fed mostly corners that died at their
+  // first track. 1: every frame.
+  double refill_below = 1.0;
+  // The new corners are taken strongest first over the whole image (the weaker RMS gradient of
+  // their structure tensor), each cell up to its quota: where the image has strong corners the
+  // weak ones (noise on a plain wall, a tile's faint pattern: on the rendered room and TartanAir
+  // 58-97 % of the corners weaker than 0.5 grey levels per pixel died at their first track,
+  // 6-12 % of those above 2) are left out, and where it has none the weak ones still fill it.
+  // false: each cell's own strongest, by goodFeaturesToTrack's quality alone.
+  bool strongest_first = true;
+  // With strongest_first, corners weaker than weak_corner_gradient (RMS grey levels per pixel)
+  // are taken only while the tracker holds fewer than weak_corner_share of max_features: a plain
+  // wall's faint corners are what keeps a blank corridor's pose, but where the image has strong
+  // corners the weak ones mostly die young and bend the pose.
+  double weak_corner_gradient = 1.0;
+  double weak_corner_share = 0.25;
   // Re-detection in half the grid's cells per frame, as on a checkerboard whose colours take
   // turns: each cell is refilled every other frame. Most new corners die at their first track
   // (51-70 % on the evaluation sets), so refilling every frame mostly feeds the forward-backward
@@ -69,15 +86,30 @@ struct KltTrackerOptions {
   bool redetect_alternate = false;
 };
 
+// What the tracks cost and how long they live, since the tracker was made (resets included): the
+// work per frame is the features handled, and a feature that dies at its first track bought
+// nothing.
+struct KltTrackStats {
+  int64_t frames = 0;          // frames tracked into
+  int64_t searched = 0;        // features searched for (forward; each also backward when found)
+  int64_t detected = 0;        // new features
+  int64_t lost = 0;            // tracks that ended (not found, or failing the check)
+  int64_t lost_at_first = 0;   // ... at their first track
+  int64_t lifetime_sum = 0;    // frames each ended track was followed
+  std::vector<int64_t> lifetimes;  // lifetimes[k]: tracks that ended after k frames (k < 64)
+  int median_lifetime() const;     // of the ended tracks, frames; 0 when none ended
+};
+
 // Re-detection's work, cell by cell (KltTracker::plan_detection, detect_cell, add_detections).
 struct KltDetection {
   int cols = 1, rows = 1, cell_w = 1, cell_h = 1;
   std::vector<int> wanted;  // per cell: the corners to look for (its quota minus its tracks)
   cv::Mat mask;             // 0 within min_distance_px of a tracked feature
-  // Per cell: its corners, strongest first (image pixels), and whether each is strong enough
-  // (min_corner_gradient).
+  // Per cell: its corners, strongest first (image pixels), whether each is strong enough
+  // (min_corner_gradient, min_corner_isotropy), and its weaker RMS gradient (strongest_first).
   std::vector<std::vector<cv::Point2f>> corners;
   std::vector<std::vector<char>> strong;
+  std::vector<std::vector<float>> strength;
   int cells() const { return cols * rows; }
 };
 
@@ -85,12 +117,15 @@ template <typename Visit>
 void visit_fields(KltTrackerOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(positive(), o.grid_cols, o.grid_rows, o.max_forward_backward_px,
                   o.max_iterations);
+  HYBRID_VO_FIELDS(non_negative(), o.weak_corner_gradient);
+  HYBRID_VO_FIELDS(fraction(), o.weak_corner_share);
   HYBRID_VO_FIELDS(non_negative(), o.min_distance_px, o.min_corner_gradient,
                   o.min_corner_isotropy, o.pyramid_levels, o.predicted_pyramid_levels);
-  HYBRID_VO_FIELDS(fraction(), o.redetect_min_missing);
+  HYBRID_VO_FIELDS(fraction(), o.redetect_min_missing, o.refill_below);
   HYBRID_VO_FIELDS(positive_fraction(), o.quality_level);
   HYBRID_VO_FIELDS(at_least(5), o.window_px);  // smaller windows lose the texture
-  HYBRID_VO_FIELDS(any_value(), o.predict_motion, o.drop_leaving, o.redetect_alternate);
+  HYBRID_VO_FIELDS(any_value(), o.predict_motion, o.drop_leaving, o.redetect_alternate,
+                  o.strongest_first);
 }
 
 // Sparse optical-flow tracking of corners between consecutive video frames, with re-detection in
@@ -131,6 +166,7 @@ class KltTracker {
   // next re-detection, the youngest first.
   void set_work(int max_features, double redetect_min_missing, bool redetect_alternate);
   int num_tracks() const;
+  const KltTrackStats& stats() const { return stats_; }
   // Every feature of the last frame (tracked and newly detected) and its id.
   const std::vector<cv::Point2f>& points() const { return points_; }
   const std::vector<int64_t>& ids() const { return ids_; }
@@ -158,7 +194,9 @@ class KltTracker {
   std::vector<cv::Point2f> points_;
   std::vector<cv::Point2f> motion_;  // per feature: its last image motion, NaN when new
   std::vector<int64_t> ids_;
+  std::vector<int> age_;  // per feature: the frames it has been tracked
   int64_t next_id_ = 0;
+  KltTrackStats stats_;
   double stamp_ = kNoStamp;         // of the last tracked frame
   double motion_dt_ = kNoStamp;     // the time step motion_ was measured over
 };

@@ -17,6 +17,7 @@
 #include "hybrid_vo/frontend/stage_timings.h"
 #include "hybrid_vo/estimation/rotation_only.h"
 #include "hybrid_vo/estimation/stereo_scale.h"
+#include "hybrid_vo/estimation/two_view_depth.h"
 #include "hybrid_vo/frontend/stereo.h"
 #include "hybrid_vo/frontend/vo_orientation.h"
 #include "hybrid_vo/frontend/worker_thread.h"
@@ -49,11 +50,18 @@ struct VisualOdometryOptions {
   TwoViewOptions estimator;   // preset "hybrid", VPs detected jointly from the segments
   // Frames whose points move less than this off the rotation that best explains them (median
   // transfer error to the keyframe, the parallax after the rotation: a pan is no baseline, and a
-  // slow one is not standing still) are no baseline: the keyframe stays, so that the baseline
-  // grows, until fewer than rotation_keyframe_overlap of the keyframe's point matches remain.
-  // With rotation_only_pairs they are answered all the same (else left out).
+  // slow one is not standing still) are no baseline. With rotation_only_pairs they are answered
+  // all the same (else left out).
   double min_parallax_px = 2.0;
-  double rotation_keyframe_overlap = 0.7;
+  // The keyframe is replaced once a frame's parallax after the rotation reaches
+  // keyframe_parallax_px (a baseline that fixes the translation's direction: at 30 Hz a pair of
+  // consecutive frames has 2-3 px, and its direction was 3-6 degrees off), or once fewer than
+  // keyframe_overlap of the point matches of its first pair, or fewer than keyframe_min_points,
+  // remain to measure it. Frames before that are estimated against it and answered, each with
+  // the baseline it has (or its rotation alone), so that the parallax builds up.
+  double keyframe_parallax_px = 7.0;
+  double keyframe_overlap = 0.3;
+  int keyframe_min_points = 30;
   // Rotation-only pairs: where the points' own noise explains what the rotation leaves of their
   // motion (model_selection, motion_model_selection.h), the frame's rotation against the keyframe
   // is published with an honest covariance; else the full motion's. Without a baseline (or with
@@ -66,7 +74,16 @@ struct VisualOdometryOptions {
   RotationOnlyOptions rotation_only;
   int min_point_matches = 8;  // below this and without enough segments the pair is hopeless
   int min_line_matches = 12;
-  double mono_scale = 1.0;    // length given to a unit translation without stereo
+  // Mono: the first pair's translation has this length; later pairs take the length that
+  // agrees with their keyframe's points as triangulated before (relative scale), those whose
+  // inverse depth is known to within mono_depth_max_sigma of itself; where none are, the last
+  // pair's speed. Without a baseline the translation is zero within mono_scale.
+  double mono_scale = 1.0;
+  bool mono_relative_scale = true;
+  double mono_depth_max_sigma = 0.3;
+  // A pair triangulates its points only when its translation's direction is this sure
+  // (radians; a blank wall's is not).
+  double mono_depth_max_direction_sigma = 0.05;
   StereoOptions stereo;
   StereoScaleOptions stereo_scale;  // the metric scale from the keyframe's stereo points
   DisparityOffsetOptions stereo_offset;  // self-calibration of a constant disparity offset
@@ -128,7 +145,8 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   visit_fields(o.estimator, prefixed("estimator_", visit));
   HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches);
   HYBRID_VO_FIELDS(any_value(), o.rotation_only_pairs, o.model_selection);
-  HYBRID_VO_FIELDS(fraction(), o.rotation_keyframe_overlap);
+  HYBRID_VO_FIELDS(fraction(), o.keyframe_overlap);
+  HYBRID_VO_FIELDS(non_negative(), o.keyframe_parallax_px, o.keyframe_min_points);
   visit("rotation_drift_floor_deg", o.orientation.drift_floor_deg, non_negative());
   visit("rotation_calibration_sigma", o.rotation_calibration_sigma, non_negative());
   visit("full_pair_turn_fraction", o.full_pair_turn_fraction, non_negative());
@@ -207,6 +225,9 @@ struct VisualOdometryResult {
   bool stereo_scale_attempted = false;
   StereoScaleEstimate stereo_scale;
   std::vector<StereoScaleObservation> scale_observations;
+  // Mono: the keyframe points that gave the translation's length (relative scale; 0: none, the
+  // length carried from the last pair's speed or mono_scale).
+  int mono_scale_points = 0;
   double disparity_offset_px = 0.0;  // the offset applied (0 until self-calibration is sure)
   Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();  // current camera into odometry
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();     // current camera centre in odometry
@@ -248,6 +269,8 @@ class VisualOdometry {
   // dropped too: its directions would be compared under a rotation that no longer holds.
   void restart();
   const DirectionMap& direction_map() const { return orientation_.direction_map(); }
+  // The KLT tracks' cost and lifetimes so far (KLT tracking only).
+  const KltTrackStats& point_track_stats() const { return klt_.stats(); }
   const VisualOdometryOptions& options() const { return options_; }
 
  private:
@@ -266,6 +289,7 @@ class VisualOdometry {
     double stamp = 0.0;
     std::map<int64_t, Eigen::Vector2d> points;          // id -> distorted pixel
     std::map<int64_t, Eigen::Vector3d> points3d;        // id -> stereo point (metres, camera)
+    std::map<int64_t, InverseDepth> depths;             // mono: id -> inverse depth (camera)
     ImageFeatures features;                             // segments (and descriptor points)
     std::map<int64_t, LineSegment> external_lines;      // id -> segment
     std::map<int64_t, LineSegment> tracked_lines;       // LineTracker id -> segment
@@ -335,7 +359,8 @@ class VisualOdometry {
   };
   bool low_parallax(const Frame& f) const;
   Pairing decide_keyframe(Frame& f);
-  // A frame without a baseline leaves the keyframe in place while enough of its points are seen.
+  // A frame leaves the keyframe in place while its parallax is short of keyframe_parallax_px (or
+  // it has no baseline) and enough of the keyframe's points are seen.
   bool keeps_keyframe(const Frame& f) const;
   VisualOdometryResult keep_as_keyframe(Frame& f);  // the frame's end: it becomes the keyframe
   VisualOdometryResult skip_frame(Frame& f);        // the frame's end: the keyframe stays
@@ -343,6 +368,12 @@ class VisualOdometry {
   // Keyframe::stereo_pending).
   void make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> points,
                      std::vector<int64_t> pending);
+
+  // vo_mono_scale.cc: in mono, the inverse depths a frame becoming the keyframe knows of its
+  // points (from its pair with the keyframe before, and carried over from it); the relative scale
+  // of a pair with a baseline from its keyframe's (false: none found).
+  std::map<int64_t, InverseDepth> keyframe_depths(const Frame& f) const;
+  bool fit_mono_scale(Frame& f, double* scale, double* sigma) const;
 
   // vo_estimation.cc: the pair's matches undistorted, its VPs and their priors; its full pose
   // (false: none found), which may yet show no translation (f.rotation_only); or its rotation
@@ -403,6 +434,9 @@ class VisualOdometry {
   double last_stamp_ = -1e300;
   // The last frame answered with a pose (rotation-only frames included): the rotation rate.
   double last_answer_stamp_ = -1e300;
+  // Mono: the last pair's translation length per second, for a pair whose keyframe knows no
+  // depths (negative: none yet).
+  double mono_speed_ = -1.0;
   Eigen::Matrix3d last_answer_R_wc_ = Eigen::Matrix3d::Identity();
   // Kept across reset(): the machine's load does not change with the trajectory.
   CpuBudget budget_;
