@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -245,6 +246,31 @@ TEST(BenchFrontendCli, LowTextureLinesHoldTheOrientation) {
   const double with_points = number_after(points.output, last);
   EXPECT_LT(with_lines, 0.6 * with_points) << lines.output << points.output;
   EXPECT_LT(with_lines, 10.0) << lines.output;
+}
+
+// Issue 52, on the shared KITTI 06 street when present: its facades are not parallel to each
+// other, and the map of directions once re-acquired the wrong one (2.07 degrees at the last frame
+// against 0.94 without the map). Now the map is never worse than the pairs alone, as the issue's
+// acceptance asks: over 1 s at most 1.05x + 0.01 degrees, the last frame 1.1x + 0.02, the
+// largest 1.1x + 0.05.
+TEST(BenchFrontendCli, KittiStreetTheMapIsNeverWorse) {
+  const std::string data = shared_data("kitti06_stereo_51");
+  if (!std::ifstream(data + "/sequences/06/times.txt")) GTEST_SKIP() << data << " not present";
+  const std::string args = data + "/sequences/06 --sequential --seed 1";
+  const Outcome with = run("hybrid_vo_bench_frontend", args);
+  const Outcome without = run("hybrid_vo_bench_frontend", args + " --no-direction-map");
+  ASSERT_EQ(with.exit_code, 0) << with.output;
+  ASSERT_EQ(without.exit_code, 0) << without.output;
+  // Over 1 s, at the last frame, at most.
+  const std::regex line(R"(([\d.]+) over [\d.]+ s windows \(\d+\), orientation against the first )"
+                        R"(frame ([\d.]+) at the last frame and ([\d.]+) at most)");
+  std::smatch a, b;
+  ASSERT_TRUE(std::regex_search(with.output, a, line)) << with.output;
+  ASSERT_TRUE(std::regex_search(without.output, b, line)) << without.output;
+  const double factor[] = {1.05, 1.1, 1.1}, offset[] = {0.01, 0.02, 0.05};
+  for (int k = 0; k < 3; ++k)
+    EXPECT_LE(std::stod(a[k + 1]), factor[k] * std::stod(b[k + 1]) + offset[k])
+        << a[0] << "\nwithout the map: " << b[0];
 }
 
 TEST(BenchFrontendCli, BadDirectGap) {

@@ -46,7 +46,8 @@ void usage(const char* program) {
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
-               " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]\n"
+               " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]"
+               " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]\n"
                "       [--stereo-translation-margin M] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
@@ -54,6 +55,11 @@ void usage(const char* program) {
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
                "  the KLT corners' strength floor (0: every corner); --min-corner-isotropy R: a\n"
                "  corner's weaker gradient at least R times its stronger (klt_min_corner_isotropy);\n"
+               "  --no-strongest-first: KLT corners cell by cell in detection order, as before issue\n"
+               "  53 (default: strongest first, corners weaker than --weak-corner-gradient only\n"
+               "  while fewer than --weak-corner-share of --max-features are tracked);\n"
+               "  --keyframe-parallax P: the keyframe stays until this parallax (px; 0: until a\n"
+               "  baseline); --keyframe-overlap F: ... or fewer than F of its points remain;\n"
                "  --drop-leaving: KLT drops\n"
                "  the features predicted outside the image unsearched; --no-anchor: no orientation\n"
                "  correction by the map of directions; --no-direction-map (old name:\n"
@@ -191,6 +197,7 @@ int run(int argc, char** argv) {
     else if (a == "--drop-leaving") o.klt.drop_leaving = true;
     else if (a == "--redetect-alternate") o.klt.redetect_alternate = true;
     else if (a == "--strongest-first") o.klt.strongest_first = true;
+    else if (a == "--no-strongest-first") o.klt.strongest_first = false;
     else if (a == "--weak-corner-gradient" && i + 1 < argc)
       o.klt.weak_corner_gradient = std::atof(argv[++i]);
     else if (a == "--weak-corner-share" && i + 1 < argc)
