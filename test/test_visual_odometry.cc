@@ -547,6 +547,53 @@ TEST(KltTracker, IsotropyLeavesOutPointsOnStraightEdges) {
   EXPECT_GE(corners_default, corners_all * 9 / 10);
 }
 
+// refill_below: a pan over a texture with fewer good corners than max_features. While most of
+// what the last re-detection left is still tracked no cell looks for corners; once a fifth of it
+// has left the view, every empty cell does.
+TEST(KltTracker, RefillWaitsUntilAShareOfTheLastRefillIsLost) {
+  const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1400, 2.5);
+  auto frame = [&](double shift) {
+    const cv::Matx23d warp(1, 0, -150 + shift, 0, 1, -100);
+    cv::Mat image;
+    cv::warpAffine(texture, image, warp, cv::Size(640, 480),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP);
+    return image;
+  };
+  KltTrackerOptions options;
+  options.refill_below = 0.8;
+  KltTracker tracker(options, 3000);  // more than the texture's corners: the cap is never met
+  tracker.track(frame(0.0), nullptr, 0.0);
+  const int filled = tracker.num_tracks();
+  ASSERT_GT(filled, 200);
+  ASSERT_LT(filled, 0.8 * 3000);
+  auto wanting = [&] {
+    const KltDetection d = tracker.plan_detection();
+    int cells = 0;
+    for (int c = 0; c < d.cells(); ++c) cells += d.wanted[c] > 0;
+    return cells;
+  };
+  double shift = 0.0;
+  int k = 1;
+  for (; k < 40; ++k) {
+    shift += 8.0;
+    tracker.track_existing(frame(shift), nullptr, 0.1 * k);
+    if (tracker.num_tracks() < 0.8 * filled) break;
+    EXPECT_EQ(wanting(), 0) << "frame " << k << ": " << tracker.num_tracks() << " of " << filled;
+    tracker.detect_new();
+  }
+  ASSERT_LT(k, 40) << "the pan never lost a fifth of the tracks";
+  EXPECT_GT(k, 3);
+  EXPECT_GT(wanting(), 0);
+  // Always (1, the default): every frame's cells look, as before.
+  KltTracker always(KltTrackerOptions(), 3000);
+  always.track(frame(0.0), nullptr, 0.0);
+  always.track_existing(frame(8.0), nullptr, 0.1);
+  const KltDetection d = always.plan_detection();
+  int cells = 0;
+  for (int c = 0; c < d.cells(); ++c) cells += d.wanted[c] > 0;
+  EXPECT_GT(cells, 0);
+}
+
 TEST(KltTracker, AlternateRedetectionFillsHalfTheCellsByTurns) {
   const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1000, 2.5);
   auto frame = [&](int k) {  // a pan: features leave on one side, cells empty on the other

@@ -82,6 +82,7 @@ void KltTracker::reset() {
   age_.clear();
   stamp_ = motion_dt_ = kNoStamp;
   detections_ = 0;
+  refilled_to_ = 0;
 }
 
 int KltTracker::num_tracks() const { return static_cast<int>(points_.size()); }
@@ -308,9 +309,14 @@ KltDetection KltTracker::plan_detection() const {
   d.wanted.resize(d.cells());
   const int min_missing = static_cast<int>(std::ceil(options_.redetect_min_missing * quota));
   const bool alternate = options_.redetect_alternate && !points_.empty();
-  // Enough tracks: no re-detection at all this frame.
-  const bool enough = !points_.empty() &&
-                      points_.size() >= options_.refill_below * max_features;
+  // Enough tracks: no re-detection at all this frame. Enough is measured against what the last
+  // re-detection left too: where the image has fewer good corners than max_features (a room's
+  // walls), the tracks never reach the cap, and a re-detection every frame would pay to find the
+  // same weak corners again.
+  const double refill = options_.refill_below;
+  const bool enough = !points_.empty() && refill < 1.0 &&
+                      (points_.size() >= refill * max_features ||
+                       static_cast<double>(points_.size()) >= refill * refilled_to_);
   for (int c = 0; c < d.cells(); ++c) {
     d.wanted[c] = enough ? 0 : quota - count[c];
     if (d.wanted[c] < min_missing) d.wanted[c] = 0;
@@ -427,6 +433,11 @@ void KltTracker::add_detections(const KltDetection& d) {
     ids_ = std::move(kept_ids);
     age_ = std::move(kept_age);
   }
+  for (int c = 0; c < cells; ++c)
+    if (d.wanted[c] > 0) {
+      refilled_to_ = static_cast<int>(points_.size());
+      break;
+    }
 }
 
 }  // namespace hybrid_vo

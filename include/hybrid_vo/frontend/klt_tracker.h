@@ -59,9 +59,9 @@ struct KltTrackerOptions {
   // A cell is re-detected only once it misses this fraction of its quota: finding one or two
   // corners costs goodFeaturesToTrack over the whole cell, and most new features die young.
   double redetect_min_missing = 0.0;
-  // Re-detection only once the tracks fall below this share of max_features: a frame that lost a
-  // few tracks needs no new ones, and refilling every frame fed mostly corners that died at their
-  // first track. 1: every frame.
+  // Re-detection only once the tracks fall below this share of max_features, or of the tracks
+  // the last re-detection left: a frame that lost a few tracks needs no new ones, and refilling
+  // every frame fed mostly corners that died at their first track. 1: every frame.
   double refill_below = 1.0;
   // The new corners are taken strongest first over the whole image (the weaker RMS gradient of
   // their structure tensor), each cell up to its quota: where the image has strong corners the
@@ -189,6 +189,7 @@ class KltTracker {
   KltTrackerOptions options_;
   int max_features_;
   int64_t detections_ = 0;  // re-detections added since the last reset (redetect_alternate)
+  int refilled_to_ = 0;     // the tracks after the last re-detection that looked for corners
   cv::Size size_;
   std::vector<cv::Mat> previous_;  // image pyramid with derivatives, built once per frame
   std::vector<cv::Point2f> points_;
