@@ -622,8 +622,50 @@ TEST(CameraMotion, RampRestsThenReachesTheWalk) {
   EXPECT_NEAR(previous, 1.5, 1e-3);
 }
 
+// Hand-held (issue 53): a stroll at 0.09 m/s from the command line, looking around at up to
+// about 9-15 deg/s with a shake, smooth frame to frame at 30 Hz, inside the room.
+TEST(CameraMotion, HandheldStrollsSlowlyAndLooksAround) {
+  SequenceOptions options;
+  ASSERT_EQ(parse_sequence_args({"--kitti-dir", "x", "--scene", "room", "--motion", "handheld",
+                                 "--rate", "30", "--frames", "300"},
+                                &options),
+            "");
+  EXPECT_EQ(options.motion, Motion::kHandheld);
+  EXPECT_DOUBLE_EQ(options.speed, 0.09);
+  const Scene scene = motion_scene(SceneType::kRoom);
+  PathOptions o;
+  o.motion = Motion::kHandheld;
+  o.rate_hz = 30.0;
+  o.num_frames = 300;
+  o.speed = 0.09;
+  const Trajectory hand = make_trajectory(scene, o);
+  double path = 0.0, peak_rate = 0.0, turned = 0.0, peak_step = 0.0;
+  for (int i = 1; i < 300; ++i) {
+    const double step = (hand.poses[i].centre - hand.poses[i - 1].centre).norm();
+    const double angle = Eigen::AngleAxisd(hand.poses[i].R_world_from_camera.transpose() *
+                                           hand.poses[i - 1].R_world_from_camera)
+                             .angle() * 180.0 / kPi;
+    path += step;
+    turned += angle;
+    peak_step = std::max(peak_step, step);
+    peak_rate = std::max(peak_rate, angle * 30.0);
+  }
+  // 10 s: 0.9 m along the route, plus the hand's drift; it turns, but slowly.
+  EXPECT_GT(path, 0.9);
+  EXPECT_LT(path, 2.0);
+  EXPECT_LT(peak_step, 0.02);
+  EXPECT_GT(peak_rate, 5.0);
+  EXPECT_LT(peak_rate, 25.0);
+  EXPECT_GT(turned, 40.0);
+  // Repeatable, and the seed sets the swings' phases.
+  const Trajectory again = make_trajectory(scene, o);
+  EXPECT_EQ(again.poses[123].centre, hand.poses[123].centre);  // repeatable
+  o.seed = 2;
+  EXPECT_NE(make_trajectory(scene, o).poses[123].centre, hand.poses[123].centre);
+}
+
 TEST(CameraMotion, EveryMotionIsRenderedInStereo) {
-  for (const char* motion : {"walk", "rest", "turn", "ramp"}) {
+  for (const char* motion : {"walk", "rest", "turn", "ramp", "handheld"}) {
     std::vector<std::string> args = {"--out",  "x.bag", "--stereo", "--motion", motion,
                                      "--frames", "12", "--width", "64", "--height",
                                      "48",     "--scene", "room"};

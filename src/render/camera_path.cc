@@ -82,6 +82,9 @@ class CameraPath {
                          full_sway * smooth_ramp(moving, o_.ramp_seconds), heading);
         break;
       }
+      case Motion::kHandheld:
+        pose = handheld_pose(time, heading);
+        break;
     }
     return pose;
   }
@@ -122,6 +125,33 @@ class CameraPath {
     return pose;
   }
 
+  // kHandheld: the route's point and heading at the stroll's arc length, the hand's slow swings
+  // and drift (periods of 3-10 s, incommensurate, with the seed's phases) and its shake.
+  CameraPose handheld_pose(double time, double* heading) const {
+    Eigen::Vector2d pos = Eigen::Vector2d::Zero(), tangent = Eigen::Vector2d::UnitX();
+    const double s = o_.start + o_.speed * time;
+    point_on_route(pieces_, total_, s, &pos, &tangent);
+    walk_pose(s, 0.0, heading);  // for its smoothed heading
+    const auto wave = [&](double amplitude, double period, int k) {
+      return amplitude * std::sin(2.0 * kPi * time / period + phase_[k % 6] + k);
+    };
+    const Eigen::Vector2d left(-tangent.y(), tangent.x());
+    pos += (wave(0.10, 8.1, 0) + wave(0.0015, 1.0 / 1.7, 1)) * left;
+    const double z = o_.camera_height + wave(0.03, 6.2, 2) + wave(0.0015, 1.0 / 2.3, 3);
+    const double yaw = *heading + look_left_ + (wave(12.0, 9.0, 4) + wave(3.0, 3.1, 5) +
+                                                wave(0.15, 1.0 / 2.1, 6)) * kDeg;
+    const double pitch = (o_.pitch_down_deg + wave(4.0, 7.3, 7) + wave(0.15, 1.0 / 3.3, 8)) * kDeg;
+    const double roll = (wave(1.5, 5.7, 9) + wave(0.15, 1.0 / 4.7, 10)) * kDeg;
+    const Eigen::Matrix3d R_world_from_base = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                                  .toRotationMatrix();
+    CameraPose pose;
+    pose.R_world_from_camera = R_world_from_base * base_from_optical();
+    pose.centre = Eigen::Vector3d(pos.x(), pos.y(), z);
+    return pose;
+  }
+
   PathOptions o_;
   std::vector<RoutePiece> pieces_;
   double total_ = 0.0, look_left_ = 0.0, duration_ = 0.0;
@@ -149,7 +179,7 @@ CameraPose stereo_right(const CameraPose& left, double baseline) {
 double route_length(const Scene& scene) { return route_length(route_pieces(scene)); }
 
 bool parse_motion(const std::string& name, Motion* motion) {
-  for (Motion m : {Motion::kWalk, Motion::kRest, Motion::kTurn, Motion::kRamp})
+  for (Motion m : {Motion::kWalk, Motion::kRest, Motion::kTurn, Motion::kRamp, Motion::kHandheld})
     if (name == to_string(m)) {
       *motion = m;
       return true;
@@ -167,6 +197,8 @@ const char* to_string(Motion motion) {
       return "turn";
     case Motion::kRamp:
       return "ramp";
+    case Motion::kHandheld:
+      return "handheld";
   }
   return "?";
 }

@@ -33,10 +33,11 @@ std::string sequence_usage(const std::string& program) {
     << "                     (low texture: only the edges of walls, boxes, doors, floor joints)\n"
     << "  --baseline M       stereo baseline in metres (default 0.12)\n"
     << "  --speed M_PER_S    walking speed (default 1.5)\n"
-    << "  --motion walk|rest|turn|ramp  how the camera moves (default walk): walk along the\n"
-    << "                     route; rest: stand still at its start (only the noise changes);\n"
-    << "                     turn: turn in place there like a wheeled robot; ramp: rest, then\n"
-    << "                     start walking\n"
+    << "  --motion walk|rest|turn|ramp|handheld  how the camera moves (default walk): walk\n"
+    << "                     along the route; rest: stand still at its start (only the noise\n"
+    << "                     changes); turn: turn in place there like a wheeled robot; ramp:\n"
+    << "                     rest, then start walking; handheld: a hand-held camera strolling\n"
+    << "                     along the route (--speed default 0.09) and looking around, shaking\n"
     << "  --lever-arm M      turn: the vertical axis this far behind the camera (default 0.2;\n"
     << "                     0: about the camera centre)\n"
     << "  --turn-rate DEG_S  turn: the yaw rate after a smooth 1 s ramp (default 30; negative:\n"
@@ -62,6 +63,7 @@ std::string sequence_usage(const std::string& program) {
 
 std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOptions* o) {
   std::vector<std::string> motion_options;  // given, to check against the motion at the end
+  bool speed_given = false;
   ImagingArguments imaging;
   bool noise_given = false;
   for (size_t i = 0; i < args.size(); ++i) {
@@ -133,6 +135,7 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       ok = parse_double(v, 0.0, 2.0, true, &o->baseline);
     } else if (arg == "--speed") {
       ok = parse_double(v, 0.0, 5.0, true, &o->speed);
+      speed_given = true;
     } else if (arg == "--focal") {
       ok = parse_double(v, 0.0, 1e5, true, &o->focal);
     } else if (arg == "--noise") {
@@ -165,6 +168,7 @@ std::string parse_sequence_args(const std::vector<std::string>& args, SequenceOp
       motion_options.push_back(arg);
     if (!ok) return "bad value '" + v + "' for " + arg;
   }
+  if (o->motion == Motion::kHandheld && !speed_given) o->speed = 0.09;
   o->imaging = resolve_imaging(imaging, noise_given, &o->noise);
   if (o->out_bag.empty() && o->kitti_dir.empty())
     return "--out OUT.bag or --kitti-dir DIR is required";

@@ -43,9 +43,14 @@ enum class Motion {
   kRest,  // standing at the route's start, without sway: only the sensor noise changes
   kTurn,  // a wheeled robot turning in place at the route's start, about a vertical axis
   kRamp,  // at rest, then accelerating to `speed`, then the walk
+  // A camera held in the hand of someone strolling along the route at `speed` (0.09 m/s from
+  // the command line) and looking around: slow yaw, pitch and roll swings (about 9 deg/s at
+  // their peak), the hand's drift (10 cm sideways, 3 cm up and down) and its shake (0.15 deg,
+  // 1.5 mm at 2-5 Hz). A slow hand-held camera at 30 Hz has a few pixels of parallax per second.
+  kHandheld,
 };
 
-// Parses "walk", "rest", "turn" or "ramp"; false for anything else.
+// Parses "walk", "rest", "turn", "ramp" or "handheld"; false for anything else.
 bool parse_motion(const std::string& name, Motion* motion);
 const char* to_string(Motion motion);
 
