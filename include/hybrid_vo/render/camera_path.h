@@ -44,9 +44,9 @@ enum class Motion {
   kTurn,  // a wheeled robot turning in place at the route's start, about a vertical axis
   kRamp,  // at rest, then accelerating to `speed`, then the walk
   // A camera held in the hand of someone strolling along the route at `speed` (0.09 m/s from
-  // the command line) and looking around: slow yaw, pitch and roll swings (the yaw 8 deg/s typical, 15 at
-  // most), the hand's drift (10 cm sideways, 3 cm up and down) and its shake (0.15 deg,
-  // 1.5 mm at 2-5 Hz). A slow hand-held camera at 30 Hz has a few pixels of parallax per second.
+  // the command line) and looking around: slow yaw, pitch and roll swings (the yaw 8 deg/s
+  // typical, 15 at most), the hand's drift (10 cm sideways, 3 cm up and down) and its shake
+  // (0.15 deg, 1.5 mm at 2-5 Hz). At 30 Hz it has a few pixels of parallax per second.
   kHandheld,
 };
 
