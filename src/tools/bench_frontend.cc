@@ -47,7 +47,8 @@ void usage(const char* program) {
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
                " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]"
-               " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]\n"
+               " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
+               " [--independent-translation-points N]\n"
                "       [--stereo-translation-margin M] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
@@ -58,6 +59,8 @@ void usage(const char* program) {
                "  --no-strongest-first: KLT corners cell by cell in detection order, as before issue\n"
                "  53 (default: strongest first, corners weaker than --weak-corner-gradient only\n"
                "  while fewer than --weak-corner-share of --max-features are tracked);\n"
+               "  --independent-translation-points N: the points count as N independent ones in\n"
+               "  the translation direction's covariance (default 30);\n"
                "  --keyframe-parallax P: the keyframe stays until this parallax (px; 0: until a\n"
                "  baseline); --keyframe-overlap F: ... or fewer than F of its points remain;\n"
                "  --drop-leaving: KLT drops\n"
@@ -258,6 +261,8 @@ int run(int argc, char** argv) {
       o.rotation_calibration_sigma = std::atof(argv[++i]);
     else if (a == "--no-rotation-only")
       o.rotation_only_pairs = false;
+    else if (a == "--independent-translation-points" && i + 1 < argc)
+      o.estimator.covariance.independent_translation_points = std::atof(argv[++i]);
     else if ((a == "--keyframe-overlap" || a == "--rotation-keyframe-overlap") && i + 1 < argc)
       o.keyframe_overlap = std::atof(argv[++i]);
     else if (a == "--stereo-translation-margin" && i + 1 < argc)
