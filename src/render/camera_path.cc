@@ -34,6 +34,19 @@ double smooth_ramp_integral(double t, double duration) {
   return 0.5 * t - duration / (2.0 * kPi) * std::sin(kPi * t / duration);
 }
 
+// The camera at `centre` whose body (x forward, y left, z up) has this yaw, pitch and roll;
+// positive pitch tips the nose down.
+CameraPose body_pose(const Eigen::Vector3d& centre, double yaw, double pitch, double roll) {
+  const Eigen::Matrix3d R_world_from_base = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                                             Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+                                             Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+                                                .toRotationMatrix();
+  CameraPose pose;
+  pose.R_world_from_camera = R_world_from_base * base_from_optical();
+  pose.centre = centre;
+  return pose;
+}
+
 // The camera's pose at any time since frame 0, for the frames and for the instants within an
 // exposure (motion blur); it copies what it needs, so it outlives the scene and options.
 class CameraPath {
@@ -114,15 +127,7 @@ class CameraPath {
     const double pitch =
         o_.pitch_down_deg * kDeg + sway * 1.2 * kDeg * std::sin(2.0 * kPi * s / 3.7 + phase_[3]);
     const double roll = sway * 0.8 * kDeg * std::sin(cycle + phase_[4]);
-    // Body frame x forward, y left, z up; positive pitch tips the nose down.
-    const Eigen::Matrix3d R_world_from_base = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                                                  .toRotationMatrix();
-    CameraPose pose;
-    pose.R_world_from_camera = R_world_from_base * base_from_optical();
-    pose.centre = Eigen::Vector3d(pos.x(), pos.y(), z);
-    return pose;
+    return body_pose(Eigen::Vector3d(pos.x(), pos.y(), z), yaw, pitch, roll);
   }
 
   // kHandheld: the route's point and heading at the stroll's arc length, the hand's slow swings
@@ -142,14 +147,7 @@ class CameraPath {
                                                 wave(0.15, 1.0 / 2.1, 6)) * kDeg;
     const double pitch = (o_.pitch_down_deg + wave(4.0, 7.3, 7) + wave(0.15, 1.0 / 3.3, 8)) * kDeg;
     const double roll = (wave(1.5, 5.7, 9) + wave(0.15, 1.0 / 4.7, 10)) * kDeg;
-    const Eigen::Matrix3d R_world_from_base = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-                                               Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-                                               Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
-                                                  .toRotationMatrix();
-    CameraPose pose;
-    pose.R_world_from_camera = R_world_from_base * base_from_optical();
-    pose.centre = Eigen::Vector3d(pos.x(), pos.y(), z);
-    return pose;
+    return body_pose(Eigen::Vector3d(pos.x(), pos.y(), z), yaw, pitch, roll);
   }
 
   PathOptions o_;
