@@ -213,7 +213,9 @@ TEST(Replay, RenderedStereoSequence) {
   ASSERT_TRUE(values.count("map Manhattan triads"));
   EXPECT_GE(std::stoi(values["map Manhattan triads"]), 1);
   ASSERT_TRUE(values.count("frames held by the map"));
-  EXPECT_GT(std::stoi(values["frames held by the map"]), options.frames / 2);
+  // The map locates each frame that moves the keyframe on; since issue 53 the keyframe stays
+  // until its parallax builds up, about every second frame here (19 of 40 held).
+  EXPECT_GT(std::stoi(values["frames held by the map"]), options.frames / 3);
   for (const char* key : {"map re-acquisitions", "map corrections rejected",
                           "pairs overruled by the map", "blank-wall frames", "orientation source"})
     EXPECT_TRUE(values.count(key)) << key;
