@@ -30,6 +30,7 @@
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/pose_error.h"
+#include "hybrid_vo/node/parameters_file.h"
 
 namespace hybrid_vo {
 namespace {
@@ -39,7 +40,8 @@ using evaluation::percentile;
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
-            << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
+            << " SEQUENCE_DIR [--config FILE [--param NAME=VALUE]...] [--frames N] [--preset P]"
+               " [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
                " [--min-corner-isotropy R]"
                " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
@@ -51,6 +53,10 @@ void usage(const char* program) {
                " [--independent-translation-points N]\n"
                "       [--stereo-translation-margin M] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
+               "  --config FILE: the node's parameters from FILE (config/*.yaml), so that the run is\n"
+               "  the node's with `config:=FILE` (without it: the KITTI settings below); --preset\n"
+               "  and --param NAME=VALUE (any node parameter) replace the file's before it is read,\n"
+               "  the other options below change the result after.\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
@@ -186,10 +192,48 @@ int run(int argc, char** argv) {
   // The truth's own noise (radians per axis) for the NEES, as in hybrid_vo_eval_trajectory.
   double truth_rotation_sigma = 0.0, truth_direction_sigma = 0.0, truth_orientation_sigma = 0.0;
   VisualOdometryOptions o;
+  // --config first: the file's options are the start that every other option changes.
+  std::string config_path;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  bool preset_given = false;
+  for (int i = 2; i + 1 < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--config") config_path = argv[++i];
+    else if (a == "--preset") preset = argv[++i], preset_given = true;
+    else if (a == "--param") {
+      const std::string p = argv[++i];
+      const size_t eq = p.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        std::cerr << "--param: expected NAME=VALUE, got '" << p << "'\n";
+        return 2;
+      }
+      overrides.emplace_back(p.substr(0, eq), p.substr(eq + 1));
+    }
+  }
+  if (!overrides.empty() && config_path.empty()) {
+    std::cerr << "--param needs --config\n";
+    return 2;
+  }
+  if (!config_path.empty()) {
+    if (preset_given) overrides.insert(overrides.begin(), {"preset", preset});
+    NodeParameters node;
+    std::vector<std::string> warnings;
+    std::string error;
+    if (!read_node_parameters_file(config_path, overrides, &node, &warnings, &error)) {
+      std::cerr << error << "\n";
+      return 2;
+    }
+    for (const std::string& w : warnings) std::cerr << config_path << ": " << w << "\n";
+    o = node.odometry;
+    preset = node.preset;
+    opencv_threads = node.opencv_threads;
+    max_features = o.features.points.max_features;
+    vp_min_inliers = o.estimator.vp_detection.min_inliers;
+  }
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else if (a == "--preset" && i + 1 < argc) preset = argv[++i];
+    else if ((a == "--preset" || a == "--config" || a == "--param") && i + 1 < argc) ++i;
     else if (a == "--sequential") o.concurrent = false;
     else if (a == "--lbd") o.track_lines = false;
     else if (a == "--min-corner-gradient" && i + 1 < argc)
@@ -274,7 +318,7 @@ int run(int argc, char** argv) {
   }
   // As the node does (its opencv_threads parameter).
   if (opencv_threads >= 0) cv::setNumThreads(opencv_threads);
-  if (!preset_options(preset, &o.estimator)) {
+  if (config_path.empty() && !preset_options(preset, &o.estimator)) {
     std::cerr << "unknown preset " << preset << "\n";
     return 2;
   }
