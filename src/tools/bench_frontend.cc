@@ -46,7 +46,8 @@ void usage(const char* program) {
                " [--min-corner-isotropy R]"
                " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
-               " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
+               " [--truth-orientation-sigma-deg S] [--truth-position-sigma-m S]"
+               " [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
                " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]"
                " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
@@ -89,7 +90,9 @@ void usage(const char* program) {
                "  of the orientation against the first frame under the orientation's covariance,\n"
                "  as hybrid_vo_eval_trajectory prints them; --truth-rotation-sigma-deg,\n"
                "  --truth-direction-sigma-deg and --truth-orientation-sigma-deg add the truth's\n"
-               "  own noise (degrees per axis) as there.\n"
+               "  own noise (degrees per axis) as there; --truth-position-sigma-m S the noise of\n"
+               "  its positions (metres per axis), which moves a pair's true direction by\n"
+               "  sqrt(2) S / baseline (a hand-held camera's millimetres matter).\n"
                "  --max-cpu-ms B: the node's max_cpu_ms, a CPU budget per frame (both threads);\n"
                "  --work-level L: its min_work_level, a fixed level 0-4 (cpu_budget.h);\n"
                "  --max-features N: the point budget (default 1500, as config/kitti.yaml);\n"
@@ -191,6 +194,7 @@ int run(int argc, char** argv) {
   int opencv_threads = 1;
   // The truth's own noise (radians per axis) for the NEES, as in hybrid_vo_eval_trajectory.
   double truth_rotation_sigma = 0.0, truth_direction_sigma = 0.0, truth_orientation_sigma = 0.0;
+  double truth_position_sigma = 0.0;  // metres per axis
   VisualOdometryOptions o;
   // --config first: the file's options are the start that every other option changes.
   std::string config_path;
@@ -290,6 +294,15 @@ int run(int argc, char** argv) {
       (a == "--truth-rotation-sigma-deg"    ? truth_rotation_sigma
        : a == "--truth-direction-sigma-deg" ? truth_direction_sigma
                                             : truth_orientation_sigma) = degrees * M_PI / 180.0;
+    }
+    else if (a == "--truth-position-sigma-m" && i + 1 < argc) {
+      char* end = nullptr;
+      truth_position_sigma = std::strtod(argv[++i], &end);
+      if (end == argv[i] || *end || !std::isfinite(truth_position_sigma) ||
+          truth_position_sigma < 0.0) {
+        std::cerr << a << ": expected metres >= 0, got '" << argv[i] << "'\n";
+        return 2;
+      }
     }
     else if (a == "--seed" && i + 1 < argc)
       o.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
@@ -460,10 +473,14 @@ int run(int argc, char** argv) {
           if (full) {
             pair_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
             error = std::max(pair_rot_deg.back(), pair_dir_deg.back());
+            // The truth's position noise moves its direction by sqrt(2) sigma / baseline.
+            const double baseline = truth_pose.t.norm();
+            const double position_part =
+                baseline > 0.0 ? std::sqrt(2.0) * truth_position_sigma / baseline : 0.0;
             pair_dir_nees.push_back(
-                valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
-                                                   C.bottomRightCorner<3, 3>(),
-                                                   truth_direction_sigma)
+                valid ? evaluation::direction_nees(
+                            r.motion.t, truth_pose.t, C.bottomRightCorner<3, 3>(),
+                            std::hypot(truth_direction_sigma, position_part))
                       : NAN);
           }
           if (r.scale_known) {
