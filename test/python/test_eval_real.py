@@ -48,6 +48,15 @@ def test_the_ratchet_fails_beyond_the_margins_and_only_there():
     # A frame no longer answered, or a measure gone missing.
     assert "answered" in eval_real.check({"a": result(2.0, 10.0, 3.0, 99)}, baseline)[0]
     assert "1 s windows" in eval_real.check({"a": result(None, 10.0, 3.0)}, baseline)[0]
+    # Where the baseline's seeds scatter, the margin is their noise, not the fixed one.
+    scattered = {"sets": {"a": result(2.0, 10.0, 3.0)}}
+    scattered["sets"]["a"]["runs"] = [{"window_deg": w, "last_deg": 10.0}
+                                      for w in (1.0, 1.5, 2.0, 2.5, 3.0)]
+    noise = eval_real.median_noise([1.0, 1.5, 2.0, 2.5, 3.0])
+    assert abs(noise - 1.2533 * 1.4826 * 0.5 / 5 ** 0.5) < 1e-12
+    assert eval_real.check({"a": result(2.0 + 2.8 * noise, 10.0, 3.0)}, scattered) == []
+    assert "noise" in eval_real.check({"a": result(2.0 + 2.9 * noise, 10.0, 3.0)}, scattered)[0]
+    assert eval_real.median_noise([1.0]) == 0.0 and eval_real.median_noise([None, 2.0]) == 0.0
     # Sets the baseline does not know are not judged.
     assert eval_real.check({"new": result(9.0, 90.0, 30.0)}, baseline) == []
 
