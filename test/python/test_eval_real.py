@@ -61,6 +61,17 @@ def test_the_ratchet_fails_beyond_the_margins_and_only_there():
     assert eval_real.check({"new": result(9.0, 90.0, 30.0)}, baseline) == []
 
 
+def test_the_map_check_names_each_set_seed_and_measure():
+    eval_real = load_script()
+    off = {"a": {"runs": [{"window_deg": 1.0, "last_deg": 2.0, "max_deg": 3.0}] * 2}}
+    on = {"a": {"runs": [{"window_deg": 1.06, "last_deg": 2.22, "max_deg": 3.35},
+                         {"window_deg": 1.07, "last_deg": 2.23, "max_deg": 3.36}]}}
+    assert eval_real.map_check(on, off) == [
+        "a seed 1: window_deg 1.070 with the map, 1.000 without (> 1.05x + 0.01)",
+        "a seed 1: last_deg 2.230 with the map, 2.000 without (> 1.1x + 0.02)",
+        "a seed 1: max_deg 3.360 with the map, 3.000 without (> 1.1x + 0.05)"]
+
+
 def test_the_bench_output_is_parsed():
     eval_real = load_script()
     out = """# answers: 458 of 458 frames after the first have a pose (100.0 %), 2 of them rotation-only
