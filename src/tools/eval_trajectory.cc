@@ -36,7 +36,7 @@ void usage(const char* program) {
             << " --bag RUN.bag --gt GT.bag [--gt-topic /ground_truth/pose] [--plot OUT.png]"
                " [--window S]\n"
                "         [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
-               " [--truth-orientation-sigma-deg S]\n"
+               " [--truth-orientation-sigma-deg S] [--truth-position-sigma-m S]\n"
                "       " << program << " --tum EST.txt GT.txt [--plot OUT.png] [--window S]\n"
                "  Per-pair rotation and translation-direction errors with AUC@5/10/20, RPE, ATE\n"
                "  after alignment (similarity without metric scale), KITTI-style drift, and a plot.\n"
@@ -52,7 +52,8 @@ void usage(const char* program) {
                "  covariance: --truth-rotation-sigma-deg to each pair's rotation,\n"
                "  --truth-direction-sigma-deg to each pair's direction,\n"
                "  --truth-orientation-sigma-deg to the orientation against the first frame\n"
-               "  (default 0 each).\n"
+               "  (default 0 each); --truth-position-sigma-m, metres per axis, moves each pair's\n"
+               "  true direction by sqrt(2) S / its baseline, added to the direction's.\n"
                "  Last line: summary: pairs=N auc5=X auc10=X auc20=X rpe_trans=X rpe_rot_deg=X ate=X\n"
                "  rot_pair_deg=X rot_window_deg=X window_s=S orient_last_deg=X orient_max_deg=X\n"
                "  dir_deg=X nees_rot_pair=X in95_rot_pair=P nees_orient=X in95_orient=P\n"
@@ -300,6 +301,7 @@ int main(int argc, char** argv) {
   double window_s = evaluation::kDefaultRotationWindowSeconds;
   // The truth's own noise (radians per axis) for the NEES.
   double truth_rotation_sigma = 0.0, truth_direction_sigma = 0.0, truth_orientation_sigma = 0.0;
+  double truth_position_sigma = 0.0;  // metres per axis
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -335,6 +337,15 @@ int main(int argc, char** argv) {
       (a == "--truth-rotation-sigma-deg"    ? truth_rotation_sigma
        : a == "--truth-direction-sigma-deg" ? truth_direction_sigma
                                             : truth_orientation_sigma) = degrees / kDeg;
+    }
+    else if (a == "--truth-position-sigma-m") {
+      const std::string v = next();
+      char* end = nullptr;
+      truth_position_sigma = std::strtod(v.c_str(), &end);
+      if (v.empty() || *end || !std::isfinite(truth_position_sigma) || truth_position_sigma < 0.0) {
+        std::cerr << "error: " << a << ": expected metres >= 0, got '" << v << "'\n";
+        return 2;
+      }
     }
     else if (a == "--tum") {
       tum_est = next();
@@ -416,8 +427,12 @@ int main(int argc, char** argv) {
         }
         dir = hybrid_vo::translation_error(t, t_gt) * kDeg;
         pair_dir.push_back(dir);
+        // The truth's position noise moves its direction by sqrt(2) sigma / baseline.
+        const double position_part =
+            t_gt.norm() > 0.0 ? std::sqrt(2.0) * truth_position_sigma / t_gt.norm() : 0.0;
         pair_dir_nees.push_back(evaluation::direction_nees(
-            t, t_gt, evaluation::covariance_block(m.covariance.data(), 3), truth_direction_sigma));
+            t, t_gt, evaluation::covariance_block(m.covariance.data(), 3),
+            std::hypot(truth_direction_sigma, position_part)));
         if (m.scale_known && t_gt.norm() > 1e-9) {
           ratio = t.norm() / t_gt.norm();
           scale_ratios.push_back(ratio);

@@ -91,6 +91,26 @@ rotation error (deg): median 0.964 per estimated pair (458), 4.047 over 1 s wind
     assert eval_real.parse("nothing")["window_deg"] is None
 
 
+def test_a_node_run_is_parsed_as_the_bench_is():
+    eval_real = load_script()
+    out = """# 0 failed, 1 skipped frames; trajectory: 19 poses compared, scale aligned 0.1493; drift 13.46 % and 919.703 deg/100 m over 6 segments
+# answers: 19 odometry messages for 19 frames, 0 rotation-only pairs; the position at most 5.3876 from the first
+# consistency: translation direction per pair (2 dof, truth sigma 0 deg): NEES median 5.63 (honest 1.386), p90 23.06, 55.6 % inside the 95 % ellipsoid (5.992); 18 of 18
+# frames answered: 19, of 20 ground-truth poses
+# per frame (median): front end 15.7 ms, estimator 3.2 ms, total 24.4 ms = 41.0 frames/s; total p95 28.2 ms, max 29.6 ms
+summary: pairs=18 auc5=22.67 auc10=45.43 auc20=65.29 rpe_trans=0.0393 rpe_rot_deg=1.9376 ate=0.0333 rot_pair_deg=1.0198 rot_window_deg=4.8843 window_s=1 orient_last_deg=4.1685 orient_max_deg=5.0738 dir_deg=5.066 nees_rot_pair=21.857 in95_rot_pair=27.8 nees_orient=2.154 in95_orient=77.8
+"""
+    r = eval_real.parse_node(out)
+    assert set(r) == set(eval_real.parse(""))
+    assert (r["window_deg"], r["last_deg"], r["max_deg"], r["pair_deg"]) == (4.8843, 4.1685, 5.0738,
+                                                                             1.0198)
+    assert (r["auc10"], r["ate"], r["rot_nees"], r["rot_inside"]) == (45.43, 0.0333, 21.857, 27.8)
+    assert (r["dir_nees"], r["dir_inside"], r["drift_percent"]) == (5.63, 55.6, 13.46)
+    # One frame of the bag was dropped: 18 answered after the first, of 19.
+    assert (r["answered"], r["frames"], r["cpu_ms"]) == (18, 19, 24.4)
+    assert eval_real.parse_node("")["window_deg"] is None
+
+
 def test_without_the_data_it_says_so_and_passes(tmp_path):
     done = subprocess.run([str(SCRIPT), "--data", str(tmp_path), "--check", str(BASELINE)],
                           capture_output=True, text=True, timeout=60)
