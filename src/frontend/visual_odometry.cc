@@ -70,6 +70,7 @@ void VisualOdometry::restart() {
   keyframe_ = Keyframe();
   last_answer_stamp_ = -1e300;
   mono_speed_ = -1.0;
+  window_.clear();
 }
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
@@ -117,7 +118,11 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   if (f.rotation_only || !f.baseline) measure_stereo_motion(f);
   orient(f);
   fit_scale(f);
-  if (keeps_keyframe(f)) return answer_without_keyframe(f);
+  if (keeps_keyframe(f)) {
+    refine_keyframe_depths(f);
+    return answer_without_keyframe(f);
+  }
+  fit_window_scale(f);
   integrate(f);
   return keep_as_keyframe(f);
 }

@@ -64,6 +64,11 @@ struct VisualOdometry::Frame {
   bool vps_detected = false;
   VoOrientation::Oriented oriented;
 
+  // A pair with a baseline (fit_scale): the covariance of its motion with a unit translation, and
+  // the length given to it with its sigma (set_length).
+  Eigen::Matrix<double, 6, 6> unit_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  double length = 0.0, length_sigma = 0.0;
+
   // The KLT re-detection for the next frame.
   KltDetection detection;
   WorkClock redetect_clock;

@@ -2,8 +2,14 @@
 // odometry's units, triangulated from the pair that made it the keyframe (and carried over from
 // the keyframe before, fused); a later pair's translation gets the length that puts those points
 // where this frame sees them. Without it every pair's translation had the same length
-// (mono_scale), which was right only while the keyframes came at equal distances.
+// (mono_scale), which was right only while the keyframes came at equal distances. Every pair with
+// a baseline refines its keyframe's depths (as SVO's depth filter refines its seeds with every
+// frame), so that a keyframe that knew none, the first, knows them after its first baseline; a
+// pair without one takes its translation from them (issue 58).
+#include <algorithm>
 #include <cmath>
+
+#include "hybrid_vo/estimation/stereo_motion.h"
 
 #include "vo_frame.h"
 
@@ -51,7 +57,7 @@ std::map<int64_t, InverseDepth> VisualOdometry::keyframe_depths(const Frame& f) 
   return depths;
 }
 
-bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) const {
+std::vector<StereoScaleObservation> VisualOdometry::depth_observations(const Frame& f) const {
   const VisualOdometryResult& r = f.result;
   const TwoViewMatches& m = r.matches;
   const std::vector<char>& inliers = r.estimate.estimate.point_inliers;
@@ -82,13 +88,25 @@ bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) cons
     for (size_t k = 0; k < kMaxPoints; ++k) every.push_back(observations[static_cast<size_t>(k * step)]);
     observations = std::move(every);
   }
+  return observations;
+}
+
+StereoScaleOptions VisualOdometry::depth_fit_options() const {
+  // The depths are the keyframe's own (no depth limit, no disparity offset); the pose stays the
+  // pair's.
   StereoScaleOptions options = options_.stereo_scale;
   options.max_depth_baselines = 0.0;
   options.disparity_offset_px = options.disparity_offset_sigma_px = 0.0;
   options.refine_motion = false;
+  return options;
+}
+
+bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) const {
+  const std::vector<StereoScaleObservation> observations = depth_observations(f);
+  const PinholeCamera& c1 = keyframe_.camera.pinhole;
   const StereoRig rig{c1.fx, c1.fy, 1.0};
   const StereoScaleEstimate fit = estimate_stereo_scale(f.oriented.scale_pose, rig, observations,
-                                                        options);
+                                                        depth_fit_options());
   f.result.mono_scale_points = fit.status == StereoScaleStatus::kOk ? fit.inliers : 0;
   // Most points must agree: where a few do (a blank wall's handful, or depths from a pair whose
   // translation was wrong), their scale is one of several (plain corridor 1: 5 of 29 points gave
@@ -103,6 +121,88 @@ bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) cons
   *sigma = fit.sigma * std::sqrt(std::max(1.0, fit.near_points /
                                                    pair_options().covariance.independent_translation_points));
   return true;
+}
+
+double VisualOdometry::mono_length_without_depths(const Frame& f) {
+  // The parallax after the rotation is about fx |t| times the points' inverse depth: against one
+  // keyframe the lengths go as the parallaxes (the first keyframe's pairs all had mono_scale
+  // until their direction was sure enough to triangulate, 40 frames of a slow hand-held camera).
+  // The keyframe's first such pair sets the unit: mono_scale, or the last pair's speed.
+  if (keyframe_.unit_parallax > 0.0 && f.parallax > 0.0)
+    return keyframe_.unit_length * f.parallax / keyframe_.unit_parallax;
+  const double dt = f.input.stamp - keyframe_.stamp;
+  const double length = mono_speed_ > 0.0 && dt > 0.0 ? mono_speed_ * dt : options_.mono_scale;
+  if (f.parallax > 0.0) {
+    keyframe_.unit_parallax = f.parallax;
+    keyframe_.unit_length = length;
+  }
+  return length;
+}
+
+bool VisualOdometry::measure_mono_translation(Frame& f) const {
+  VisualOdometryResult& r = f.result;
+  const std::vector<StereoScaleObservation> observations = depth_observations(f);
+  const PinholeCamera& c1 = keyframe_.camera.pinhole;
+  const StereoRig rig{c1.fx, c1.fy, 1.0};
+  // The rotation that explains the points is held (the pair's; the published one stays the
+  // oriented pose's), so that only the translation is measured: at rest zero within the points'
+  // noise. Its covariance is that of a fit with the rotation free as well: a rotation that is off
+  // moves every point as a translation would, and a pair without a baseline barely tells the two
+  // apart (held, the hand-held room's 22 such pairs had a direction NEES of 21). The points share
+  // their errors as a baseline's direction does: they count as at most the translation's
+  // independent points.
+  const double independent = pair_options().covariance.independent_translation_points;
+  const StereoMotionEstimate m = estimate_stereo_motion(
+      f.oriented.scale_pose.R, rig, observations, depth_fit_options(), independent, false);
+  const StereoMotionEstimate free = estimate_stereo_motion(
+      f.oriented.scale_pose.R, rig, observations, depth_fit_options(), independent, true);
+  // Most points must agree, as for the length of a pair with a baseline.
+  if (!m.ok || !free.ok || !all_finite(m.t) || !all_finite(free.covariance) ||
+      m.inliers < std::max(options_.stereo_scale.min_near_points,
+                           static_cast<int>(std::ceil(0.5 * m.points))))
+    return false;
+  r.motion.t = m.t;
+  r.motion_covariance.bottomRightCorner<3, 3>() = free.covariance.bottomRightCorner<3, 3>();
+  r.motion_covariance.topRightCorner<3, 3>().setZero();
+  r.motion_covariance.bottomLeftCorner<3, 3>().setZero();
+  r.mono_scale_points = m.inliers;
+  r.translation_from_depths = true;
+  return true;
+}
+
+void VisualOdometry::refine_keyframe_depths(const Frame& f) {
+  const VisualOdometryResult& r = f.result;
+  // A keyframe that knew no depths as it was made (the first one, after a blank wall) takes them
+  // from a pair whose direction is less sure: their errors are alike (a direction that is off
+  // stretches them all), so the lengths fitted to them keep one unit.
+  const double max_sigma = (keyframe_.made_depths.empty() ? 3.0 : 1.0) *
+                           options_.mono_depth_max_direction_sigma;
+  if (f.stereo || !r.baseline || !r.motion_covariance_valid || !(r.motion.t.norm() > 0.0) ||
+      translation_direction_sigma(r) > max_sigma)
+    return;
+  const TwoViewMatches& m = r.matches;
+  const std::vector<char>& inliers = r.estimate.estimate.point_inliers;
+  const PinholeCamera& c1 = keyframe_.camera.pinhole;
+  const PinholeCamera& c2 = f.input.camera.pinhole;
+  const double sigma_n = options_.stereo_scale.point_sigma_px / c2.fx;
+  // Each point triangulated in the keyframe (the pair turned around: its second camera is the
+  // keyframe). Of the pairs so far each point keeps its surest triangulation, usually the latest
+  // (the parallax grows): fusing them all would count the keyframe's own sighting, which they
+  // share, again with each pair.
+  const RelativePose back = RelativePose(r.motion.R, r.motion.t).inverse();
+  for (size_t i = 0; i < m.points.size() && i < f.point_ids.size(); ++i) {
+    if (i >= inliers.size() || !inliers[i]) continue;
+    const int64_t id = f.point_ids[i];
+    const InverseDepth d = triangulate_inverse_depth(back.R, back.t, c2.normalize(m.points[i].x2),
+                                                     c1.normalize(m.points[i].x1), sigma_n);
+    if (!d.ok) continue;
+    const auto best = keyframe_.pair_depths.find(id);
+    if (best != keyframe_.pair_depths.end() && !(d.sigma < best->second.sigma)) continue;
+    keyframe_.pair_depths[id] = d;
+    const auto made = keyframe_.made_depths.find(id);
+    keyframe_.depths[id] =
+        made == keyframe_.made_depths.end() ? d : fuse_inverse_depths(made->second, d);
+  }
 }
 
 }  // namespace hybrid_vo

@@ -46,7 +46,7 @@ void usage(const char* program) {
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
                " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
-               " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]"
+               " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P] [--mono-window K]"
                " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
                " [--independent-translation-points N]\n"
                "       [--stereo-translation-margin M] [--verbose]\n"
@@ -94,7 +94,9 @@ void usage(const char* program) {
                "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
                "  (rotation_only_pairs: false); --rotation-keyframe-overlap F: the node's\n"
                "  keyframe_overlap; --keyframe-parallax P: keyframe_parallax_px (0: every frame\n"
-               "  with a baseline becomes the keyframe). --stereo-translation-margin M: a stereo pair takes\n"
+               "  with a baseline becomes the keyframe). --mono-window K: mono_window_keyframes (a new\n"
+               "  keyframe link's length fitted with the last links over K keyframes; < 3: off).\n"
+               "  --stereo-translation-margin M: a stereo pair takes\n"
                "  the stereo points' translation where its covariance is M times smaller (0:\n"
                "  never; default 2).\n";
 }
@@ -223,6 +225,8 @@ int run(int argc, char** argv) {
       o.orientation.map.min_direction_sigma_deg = std::atof(argv[++i]);
     else if (a == "--keyframe-parallax" && i + 1 < argc)
       o.keyframe_parallax_px = std::atof(argv[++i]);
+    else if (a == "--mono-window" && i + 1 < argc)
+      o.mono_window_keyframes = std::atoi(argv[++i]);
     else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
@@ -332,6 +336,8 @@ int run(int argc, char** argv) {
   // The rotation and translation direction errors of the estimated pairs (status OK), as
   // hybrid_vo_eval_trajectory takes them from the node's MotionEstimate messages.
   std::vector<double> pair_rot_deg, pair_dir_deg;
+  // Mono pairs without a baseline whose translation the keyframe's depths measured.
+  std::vector<double> depth_dir_deg, depth_dir_nees;
   evaluation::Trajectory estimate, truth, odometry;
   // Stamps from times.txt (1 s added, as kitti_to_bag does), so that a sequence with frames left
   // out has the gaps a live camera's dropped frames leave; 10 Hz without the file.
@@ -358,7 +364,7 @@ int run(int argc, char** argv) {
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
   // Keyframes, and the answered frames a second after the first and those of them with a baseline.
-  int keyframes = 1, late_answers = 0, late_baselines = 0;
+  int keyframes = 1, late_answers = 0, late_baselines = 0, late_translations = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
   evaluation::DirectionSightings vp_sightings;  // the VP observations' NEES (2 dof)
   double farthest = 0.0;             // of the position from the first frame's
@@ -417,6 +423,14 @@ int run(int argc, char** argv) {
             pair_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
             error = std::max(pair_rot_deg.back(), pair_dir_deg.back());
             pair_dir_nees.push_back(
+                valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
+                                                   C.bottomRightCorner<3, 3>(),
+                                                   truth_direction_sigma)
+                      : NAN);
+          }
+          if (!full && r.translation_from_depths && truth_pose.t.norm() > 0.0) {
+            depth_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
+            depth_dir_nees.push_back(
                 valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
                                                    C.bottomRightCorner<3, 3>(),
                                                    truth_direction_sigma)
@@ -588,6 +602,11 @@ int run(int argc, char** argv) {
     if (answered(r.status) && input.stamp - stamps[0] >= 1.0) {
       ++late_answers;
       late_baselines += r.baseline;
+      // Its translation measured: by a baseline, or without one by the keyframe's depths (mono)
+      // or stereo points.
+      late_translations += r.baseline || r.translation_from_depths ||
+                           ((r.status == VoStatus::kOk || r.status == VoStatus::kRotationOnly) &&
+                            r.scale_known);
     }
     farthest = std::max(farthest, (r.centre - odometry.front().c).norm());
     rotation_only += r.status == VoStatus::kRotationOnly;
@@ -624,9 +643,11 @@ int run(int argc, char** argv) {
               frames > 1 ? 100.0 * answered_frames / (frames - 1) : 0.0, rotation_only, farthest,
               stereo ? "m" : "per-pair units");
   std::printf("# keyframes: %d of %d frames; after the first second %d of %d answered frames have "
-              "a baseline (%.1f %%)\n",
+              "a baseline (%.1f %%), %d a measured translation (%.1f %%: with a baseline, or "
+              "without one from the keyframe's depths or stereo points)\n",
               keyframes, frames, late_baselines, late_answers,
-              late_answers > 0 ? 100.0 * late_baselines / late_answers : 0.0);
+              late_answers > 0 ? 100.0 * late_baselines / late_answers : 0.0, late_translations,
+              late_answers > 0 ? 100.0 * late_translations / late_answers : 0.0);
   {
     const KltTrackStats& t = vo.point_track_stats();
     const double per_frame = t.frames > 0 ? 1.0 / t.frames : 0.0;
@@ -714,6 +735,13 @@ int run(int argc, char** argv) {
     consistency("rotation per pair", truth_rotation_sigma, pair_rot_nees, 3, "estimated pairs");
     consistency("translation direction per pair", truth_direction_sigma, pair_dir_nees, 2,
                 "estimated pairs");
+    if (!depth_dir_nees.empty()) {
+      std::printf("median direction error of the translations without a baseline (from the "
+                  "keyframe's depths) %.2f deg\n",
+                  median(depth_dir_deg));
+      consistency("translation direction without a baseline, from the keyframe's depths",
+                  truth_direction_sigma, depth_dir_nees, 2, "pairs");
+    }
     consistency("orientation against the first frame", truth_orientation_sigma, orientation_nees,
                 3, "estimated frames");
     if (stereo)
