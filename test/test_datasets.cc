@@ -30,6 +30,7 @@
 #include "hybrid_vo/datasets/readers.h"
 #include "hybrid_vo/datasets/sequence.h"
 #include "hybrid_vo/datasets/text_file.h"
+#include "hybrid_vo/datasets/undistorted_kitti.h"
 #include "hybrid_vo/geometry/rotation.h"
 
 namespace hybrid_vo {
@@ -529,6 +530,72 @@ TEST(KittiWriter, RefusesBadInputWithTheReason) {
   KittiWriter again;
   EXPECT_FALSE(again.open(root, "a", camera, 0.0, &error));
   EXPECT_TRUE(contains(error, "already exists"));
+}
+
+// A distorted sequence in the KITTI layout: a spot at a distorted pixel lands at its undistorted
+// pixel, times start at zero, the poses read back as they were, and what the layout cannot hold
+// is refused.
+TEST(UndistortedKitti, UndistortsTheImagesAndKeepsTimesAndPoses) {
+  TempDir dir;
+  CameraModel camera;
+  camera.pinhole = PinholeCamera(517.3, 516.5, 318.6, 255.3, 640, 480);
+  camera.distortion = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};  // TUM fr1's lens
+  const Eigen::Vector2d undistorted(520.0, 400.0);
+  const Eigen::Vector2d distorted = camera.distort(undistorted);
+  ASSERT_GT((distorted - undistorted).norm(), 5.0);
+  PoseChain chain(3);
+  Sequence sequence;
+  for (int i = 0; i < 3; ++i) {
+    cv::Mat image(480, 640, CV_8UC3, cv::Scalar::all(0));
+    cv::circle(image, cv::Point(cvRound(distorted.x()), cvRound(distorted.y())), 3,
+               cv::Scalar::all(255), cv::FILLED);
+    Frame frame;
+    frame.image_path = (dir.path() / ("in" + std::to_string(i) + ".png")).string();
+    ASSERT_TRUE(cv::imwrite(frame.image_path, image));
+    frame.timestamp = 1305031102.175304 + 0.033 * i;
+    frame.R_wc = chain.R_wc[i];
+    frame.c_w = chain.c_w[i];
+    frame.camera = camera;
+    sequence.frames.push_back(frame);
+  }
+  UndistortedKittiSummary summary;
+  std::string error;
+  ASSERT_TRUE(write_undistorted_kitti(sequence, (dir.path() / "out").string(), "00", &summary,
+                                      &error))
+      << error;
+  EXPECT_EQ(summary.frames, 3);
+  EXPECT_TRUE(summary.undistorted);
+  Sequence back;
+  ASSERT_TRUE(read_kitti((dir.path() / "out" / "sequences" / "00").string(), &back, &error))
+      << error;
+  ASSERT_EQ(back.size(), 3);
+  EXPECT_NEAR(back.frames[0].timestamp, 0.0, 1e-9);
+  EXPECT_NEAR(back.frames[2].timestamp, 0.066, 1e-6);
+  EXPECT_FALSE(back.frames[0].camera.has_distortion());
+  EXPECT_DOUBLE_EQ(back.frames[0].camera.pinhole.fx, 517.3);
+  expect_pose_near(relative_pose(back, 0, 1), chain.Rr, chain.tr, 1e-6);
+  const cv::Mat out = cv::imread(back.frames[1].image_path, cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(out.type(), CV_8UC1);
+  const cv::Moments m = cv::moments(out > 128, true);
+  ASSERT_GT(m.m00, 5.0);
+  EXPECT_NEAR(m.m10 / m.m00, undistorted.x(), 1.0);
+  EXPECT_NEAR(m.m01 / m.m00, undistorted.y(), 1.0);
+
+  // Refused: nothing to write, a fisheye, a second camera, an existing sequence.
+  EXPECT_FALSE(write_undistorted_kitti(Sequence(), (dir.path() / "e").string(), "00", &summary,
+                                       &error));
+  Sequence fisheye = sequence;
+  for (Frame& f : fisheye.frames) f.camera.model = LensModel::kEquidistant;
+  EXPECT_FALSE(write_undistorted_kitti(fisheye, (dir.path() / "f").string(), "00", &summary,
+                                       &error));
+  EXPECT_TRUE(contains(error, "fisheye")) << error;
+  Sequence two = sequence;
+  two.frames[2].camera.pinhole.fx = 500.0;
+  EXPECT_FALSE(write_undistorted_kitti(two, (dir.path() / "t").string(), "00", &summary, &error));
+  EXPECT_TRUE(contains(error, "camera other")) << error;
+  EXPECT_FALSE(write_undistorted_kitti(sequence, (dir.path() / "out").string(), "00", &summary,
+                                       &error));
+  EXPECT_TRUE(contains(error, "already exists")) << error;
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "hybrid_vo/node/node_parameters.h"
+#include "hybrid_vo/node/parameters_file.h"
 
 namespace hybrid_vo {
 namespace {
@@ -238,6 +239,82 @@ TEST(NodeParameters, OldNamesStillWorkAndWarn) {
   for (const char* config : {"default", "kitti", "lamar", "low_texture"})
     EXPECT_EQ(yaml_keys(std::string("config/") + config + ".yaml").count("vp_tracker"), 0u)
         << config;
+}
+
+// The tools read config/*.yaml without a parameter server (hybrid_vo_bench_frontend --config): the
+// same types rosparam gives, the same node options, and a clear error for what is not flat.
+TEST(ParametersFile, FlatYamlTypesAsRosparamGivesThem) {
+  XmlRpcValue p;
+  std::string error;
+  ASSERT_TRUE(parse_flat_yaml("# a comment\n---\na: true   # why\nb: 3\nc: -2.5e-1\nd: .5\n"
+                              "e: hybrid+junc\nf: \"x # y\"\ng: 'q'\nh: Off\n\r\n",
+                              &p, &error))
+      << error;
+  EXPECT_EQ(p["a"].getType(), XmlRpcValue::TypeBoolean);
+  EXPECT_TRUE(static_cast<bool>(p["a"]));
+  EXPECT_EQ(p["b"].getType(), XmlRpcValue::TypeInt);
+  EXPECT_EQ(static_cast<int>(p["b"]), 3);
+  EXPECT_EQ(p["c"].getType(), XmlRpcValue::TypeDouble);
+  EXPECT_DOUBLE_EQ(static_cast<double>(p["c"]), -0.25);
+  EXPECT_DOUBLE_EQ(static_cast<double>(p["d"]), 0.5);
+  EXPECT_EQ(static_cast<std::string>(p["e"]), "hybrid+junc");
+  EXPECT_EQ(static_cast<std::string>(p["f"]), "x # y");
+  EXPECT_EQ(static_cast<std::string>(p["g"]), "q");
+  EXPECT_FALSE(static_cast<bool>(p["h"]));
+  // An empty file is an empty namespace, not an error.
+  ASSERT_TRUE(parse_flat_yaml("", &p, &error));
+  EXPECT_EQ(p.getType(), XmlRpcValue::TypeStruct);
+  EXPECT_EQ(p.size(), 0);
+}
+
+TEST(ParametersFile, WhatIsNotAFlatEntryIsRefusedWithItsLine) {
+  XmlRpcValue p;
+  for (const char* bad : {"a: 1\nnested:\n  b: 2\n", "a: 1\n  b: 2\n", "a: [1, 2]\n",
+                          "a: 1\na: 2\n", "just text\n", "a: \"open\n", "a: 99999999999\n",
+                          "a: |\n"}) {
+    std::string error;
+    EXPECT_FALSE(parse_flat_yaml(bad, &p, &error)) << bad;
+    EXPECT_NE(error.find("line "), std::string::npos) << bad << " -> " << error;
+  }
+}
+
+TEST(ParametersFile, EveryShippedConfigIsReadAsTheNodeReadsIt) {
+  for (const char* config : {"default", "kitti", "lamar", "low_texture"}) {
+    NodeParameters p;
+    std::vector<std::string> warnings;
+    std::string error;
+    const std::string path = std::string(HYBRID_VO_SOURCE_DIR) + "/config/" + config + ".yaml";
+    ASSERT_TRUE(read_node_parameters_file(path, {}, &p, &warnings, &error)) << error;
+    EXPECT_TRUE(warnings.empty()) << config << ": " << warnings.front();
+  }
+  // default.yaml holds the node's defaults; an override replaces the file's value before the
+  // file is read, so the preset's thresholds still come after it.
+  NodeParameters file, overridden;
+  std::vector<std::string> warnings;
+  std::string error;
+  const std::string path = std::string(HYBRID_VO_SOURCE_DIR) + "/config/default.yaml";
+  ASSERT_TRUE(read_node_parameters_file(path, {}, &file, &warnings, &error)) << error;
+  const NodeParameters defaults = read_node_parameters(XmlRpcValue(), &warnings);
+  EXPECT_EQ(file.preset, defaults.preset);
+  EXPECT_EQ(file.odometry.features.points.max_features,
+            defaults.odometry.features.points.max_features);
+  EXPECT_EQ(file.odometry.keyframe_parallax_px, defaults.odometry.keyframe_parallax_px);
+  EXPECT_EQ(file.odometry.estimator.ransac.enabled, defaults.odometry.estimator.ransac.enabled);
+  ASSERT_TRUE(read_node_parameters_file(
+      path, {{"preset", "hybrid+junc"}, {"max_features", "700"}, {"ransac_seed", "3"}},
+      &overridden, &warnings, &error))
+      << error;
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_EQ(overridden.preset, "hybrid+junc");
+  EXPECT_TRUE(overridden.odometry.estimator.use_junction_points);
+  EXPECT_EQ(overridden.odometry.features.points.max_features, 700);
+  EXPECT_EQ(overridden.odometry.estimator.ransac.seed, 3u);
+  EXPECT_EQ(overridden.odometry.estimator.ransac.point_threshold_px,
+            file.odometry.estimator.ransac.point_threshold_px);
+  // A missing file and a bad override are errors, not the defaults.
+  EXPECT_FALSE(read_node_parameters_file(path + ".missing", {}, &file, &warnings, &error));
+  EXPECT_NE(error.find("cannot be read"), std::string::npos);
+  EXPECT_FALSE(read_node_parameters_file(path, {{"max_features", "[1]"}}, &file, &warnings, &error));
 }
 
 TEST(OptionFields, ValidateNamesTheFirstFieldOutOfBounds) {

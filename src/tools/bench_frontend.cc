@@ -30,6 +30,7 @@
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/pose_error.h"
+#include "hybrid_vo/node/parameters_file.h"
 
 namespace hybrid_vo {
 namespace {
@@ -39,18 +40,24 @@ using evaluation::percentile;
 
 void usage(const char* program) {
   std::cerr << "Usage: " << program
-            << " SEQUENCE_DIR [--frames N] [--preset P] [--sequential] [--lbd] [--no-predict]"
+            << " SEQUENCE_DIR [--config FILE [--param NAME=VALUE]...] [--frames N] [--preset P]"
+               " [--sequential] [--lbd] [--no-predict]"
                " [--stereo] [--trajectory FILE] [--direct-gap G] [--min-corner-gradient G]"
                " [--min-corner-isotropy R]"
                " [--drop-leaving] [--no-anchor] [--no-direction-map] [--seed S]"
                " [--opencv-threads N] [--truth-rotation-sigma-deg S] [--truth-direction-sigma-deg S]"
-               " [--truth-orientation-sigma-deg S] [--max-cpu-ms B] [--work-level L]"
+               " [--truth-orientation-sigma-deg S] [--truth-position-sigma-m S]"
+               " [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
                " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P] [--mono-window K]"
                " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
                " [--independent-translation-points N]\n"
                "       [--stereo-translation-margin M] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
+               "  --config FILE: the node's parameters from FILE (config/*.yaml), so that the run is\n"
+               "  the node's with `config:=FILE` (without it: the KITTI settings below); --preset\n"
+               "  and --param NAME=VALUE (any node parameter) replace the file's before it is read,\n"
+               "  the other options below change the result after.\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
                "  tracking; --no-predict: KLT without motion prediction; --min-corner-gradient:\n"
@@ -83,7 +90,9 @@ void usage(const char* program) {
                "  of the orientation against the first frame under the orientation's covariance,\n"
                "  as hybrid_vo_eval_trajectory prints them; --truth-rotation-sigma-deg,\n"
                "  --truth-direction-sigma-deg and --truth-orientation-sigma-deg add the truth's\n"
-               "  own noise (degrees per axis) as there.\n"
+               "  own noise (degrees per axis) as there; --truth-position-sigma-m S the noise of\n"
+               "  its positions (metres per axis), which moves a pair's true direction by\n"
+               "  sqrt(2) S / baseline (a hand-held camera's millimetres matter).\n"
                "  --max-cpu-ms B: the node's max_cpu_ms, a CPU budget per frame (both threads);\n"
                "  --work-level L: its min_work_level, a fixed level 0-4 (cpu_budget.h);\n"
                "  --max-features N: the point budget (default 1500, as config/kitti.yaml);\n"
@@ -187,11 +196,50 @@ int run(int argc, char** argv) {
   int opencv_threads = 1;
   // The truth's own noise (radians per axis) for the NEES, as in hybrid_vo_eval_trajectory.
   double truth_rotation_sigma = 0.0, truth_direction_sigma = 0.0, truth_orientation_sigma = 0.0;
+  double truth_position_sigma = 0.0;  // metres per axis
   VisualOdometryOptions o;
+  // --config first: the file's options are the start that every other option changes.
+  std::string config_path;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  bool preset_given = false;
+  for (int i = 2; i + 1 < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--config") config_path = argv[++i];
+    else if (a == "--preset") preset = argv[++i], preset_given = true;
+    else if (a == "--param") {
+      const std::string p = argv[++i];
+      const size_t eq = p.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        std::cerr << "--param: expected NAME=VALUE, got '" << p << "'\n";
+        return 2;
+      }
+      overrides.emplace_back(p.substr(0, eq), p.substr(eq + 1));
+    }
+  }
+  if (!overrides.empty() && config_path.empty()) {
+    std::cerr << "--param needs --config\n";
+    return 2;
+  }
+  if (!config_path.empty()) {
+    if (preset_given) overrides.insert(overrides.begin(), {"preset", preset});
+    NodeParameters node;
+    std::vector<std::string> warnings;
+    std::string error;
+    if (!read_node_parameters_file(config_path, overrides, &node, &warnings, &error)) {
+      std::cerr << error << "\n";
+      return 2;
+    }
+    for (const std::string& w : warnings) std::cerr << config_path << ": " << w << "\n";
+    o = node.odometry;
+    preset = node.preset;
+    opencv_threads = node.opencv_threads;
+    max_features = o.features.points.max_features;
+    vp_min_inliers = o.estimator.vp_detection.min_inliers;
+  }
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
-    else if (a == "--preset" && i + 1 < argc) preset = argv[++i];
+    else if ((a == "--preset" || a == "--config" || a == "--param") && i + 1 < argc) ++i;
     else if (a == "--sequential") o.concurrent = false;
     else if (a == "--lbd") o.track_lines = false;
     else if (a == "--min-corner-gradient" && i + 1 < argc)
@@ -251,6 +299,15 @@ int run(int argc, char** argv) {
        : a == "--truth-direction-sigma-deg" ? truth_direction_sigma
                                             : truth_orientation_sigma) = degrees * M_PI / 180.0;
     }
+    else if (a == "--truth-position-sigma-m" && i + 1 < argc) {
+      char* end = nullptr;
+      truth_position_sigma = std::strtod(argv[++i], &end);
+      if (end == argv[i] || *end || !std::isfinite(truth_position_sigma) ||
+          truth_position_sigma < 0.0) {
+        std::cerr << a << ": expected metres >= 0, got '" << argv[i] << "'\n";
+        return 2;
+      }
+    }
     else if (a == "--seed" && i + 1 < argc)
       o.estimator.ransac.seed = std::strtoull(argv[++i], nullptr, 10);
     else if (a == "--vp-min-inliers" && i + 1 < argc) vp_min_inliers = std::atoi(argv[++i]);
@@ -278,7 +335,7 @@ int run(int argc, char** argv) {
   }
   // As the node does (its opencv_threads parameter).
   if (opencv_threads >= 0) cv::setNumThreads(opencv_threads);
-  if (!preset_options(preset, &o.estimator)) {
+  if (config_path.empty() && !preset_options(preset, &o.estimator)) {
     std::cerr << "unknown preset " << preset << "\n";
     return 2;
   }
@@ -422,10 +479,14 @@ int run(int argc, char** argv) {
           if (full) {
             pair_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
             error = std::max(pair_rot_deg.back(), pair_dir_deg.back());
+            // The truth's position noise moves its direction by sqrt(2) sigma / baseline.
+            const double baseline = truth_pose.t.norm();
+            const double position_part =
+                baseline > 0.0 ? std::sqrt(2.0) * truth_position_sigma / baseline : 0.0;
             pair_dir_nees.push_back(
-                valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
-                                                   C.bottomRightCorner<3, 3>(),
-                                                   truth_direction_sigma)
+                valid ? evaluation::direction_nees(
+                            r.motion.t, truth_pose.t, C.bottomRightCorner<3, 3>(),
+                            std::hypot(truth_direction_sigma, position_part))
                       : NAN);
           }
           if (!full && r.translation_from_depths && truth_pose.t.norm() > 0.0) {
