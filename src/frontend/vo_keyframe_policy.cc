@@ -98,7 +98,7 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
   keyframe_.R_wc = orientation_.R_wc();
   keyframe_.R_wc_covariance = orientation_.covariance();
   keyframe_.centre = centre_;
-  keyframe_.pose_covariance = pose_covariance_.covariance();
+  keyframe_.pose_covariance = pose_covariance_.scaled_covariance();
   keyframe_.paired_points = -1;
   last_answer_stamp_ = input.stamp;
   last_answer_R_wc_ = keyframe_.R_wc;

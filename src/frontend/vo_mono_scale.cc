@@ -16,14 +16,10 @@
 namespace hybrid_vo {
 namespace {
 
-// The largest standard deviation of the translation's direction (radians).
-double translation_direction_sigma(const VisualOdometryResult& r) {
-  const double length = r.motion.t.norm();
-  if (!(length > 0.0)) return INFINITY;
-  const Eigen::Matrix3d C = r.motion_covariance.bottomRightCorner<3, 3>() / (length * length);
-  if (!all_finite(C)) return INFINITY;
-  return std::sqrt(std::max(0.0, C.trace()));
-}
+// How much less sure than mono_depth_max_direction_sigma a direction may be for the depths of a
+// keyframe that knew none (the hand-held room's first pair with a baseline: 5.3 degrees), and for
+// a length fitted to depths.
+constexpr double kLooseDirectionFactor = 3.0;
 
 }  // namespace
 
@@ -102,6 +98,11 @@ StereoScaleOptions VisualOdometry::depth_fit_options() const {
 }
 
 bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) const {
+  // A direction that is not known to several degrees (a blank wall's: 57 degrees on the white
+  // panels) fits any length to the depths: 17 times the last pair's there, where the truth had
+  // 1.5; the caller's fallback, the last pair's speed, is surer.
+  const double direction = std::sqrt(std::max(0.0, f.unit_covariance.bottomRightCorner<3, 3>().trace()));
+  if (!(direction <= kLooseDirectionFactor * options_.mono_depth_max_direction_sigma)) return false;
   const std::vector<StereoScaleObservation> observations = depth_observations(f);
   const PinholeCamera& c1 = keyframe_.camera.pinhole;
   const StereoRig rig{c1.fx, c1.fy, 1.0};
@@ -112,7 +113,7 @@ bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) cons
   // translation was wrong), their scale is one of several (plain corridor 1: 5 of 29 points gave
   // twice the length, and every later pair inherits it).
   if (fit.status != StereoScaleStatus::kOk ||
-      fit.inliers < std::max(options_.stereo_scale.min_near_points,
+      fit.inliers < std::max(options_.mono_min_depth_points,
                              static_cast<int>(std::ceil(0.5 * fit.near_points))))
     return false;
   *scale = fit.scale;
@@ -123,20 +124,32 @@ bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) cons
   return true;
 }
 
-double VisualOdometry::mono_length_without_depths(const Frame& f) {
-  // The parallax after the rotation is about fx |t| times the points' inverse depth: against one
-  // keyframe the lengths go as the parallaxes (the first keyframe's pairs all had mono_scale
-  // until their direction was sure enough to triangulate, 40 frames of a slow hand-held camera).
-  // The keyframe's first such pair sets the unit: mono_scale, or the last pair's speed.
-  if (keyframe_.unit_parallax > 0.0 && f.parallax > 0.0)
-    return keyframe_.unit_length * f.parallax / keyframe_.unit_parallax;
+double VisualOdometry::mono_length_without_depths(const Frame& f, double* sigma) {
+  // The last pair's speed, or before any (the first keyframe) a length that goes with the
+  // parallax after the rotation, about fx |t| times the points' inverse depth: the first such
+  // pair's is the unit, mono_scale (before, every pair of the first keyframe had mono_scale until
+  // its direction was sure enough to triangulate: 40 frames of a slow hand-held camera). Not
+  // beyond the first keyframe: with parallaxes of 2-7 px the noise's share of the first pair's
+  // shrank each keyframe's unit against the last (the white panels' lengths fell twentyfold).
+  // Either is a guess, known to a factor of about e^0.5; only the very first length is exact,
+  // being the unit.
+  constexpr double kGuessSigma = 0.5;
   const double dt = f.input.stamp - keyframe_.stamp;
-  const double length = mono_speed_ > 0.0 && dt > 0.0 ? mono_speed_ * dt : options_.mono_scale;
+  if (mono_speed_ > 0.0 && dt > 0.0) {
+    *sigma = kGuessSigma * mono_speed_ * dt;
+    return mono_speed_ * dt;
+  }
+  if (keyframe_.unit_parallax > 0.0 && f.parallax > 0.0) {
+    const double length = keyframe_.unit_length * f.parallax / keyframe_.unit_parallax;
+    *sigma = kGuessSigma * length;
+    return length;
+  }
   if (f.parallax > 0.0) {
     keyframe_.unit_parallax = f.parallax;
-    keyframe_.unit_length = length;
+    keyframe_.unit_length = options_.mono_scale;
   }
-  return length;
+  *sigma = 0.0;
+  return options_.mono_scale;
 }
 
 bool VisualOdometry::measure_mono_translation(Frame& f) const {
@@ -158,7 +171,7 @@ bool VisualOdometry::measure_mono_translation(Frame& f) const {
       f.oriented.scale_pose.R, rig, observations, depth_fit_options(), independent, true);
   // Most points must agree, as for the length of a pair with a baseline.
   if (!m.ok || !free.ok || !all_finite(m.t) || !all_finite(free.covariance) ||
-      m.inliers < std::max(options_.stereo_scale.min_near_points,
+      m.inliers < std::max(options_.mono_min_depth_points,
                            static_cast<int>(std::ceil(0.5 * m.points))))
     return false;
   r.motion.t = m.t;
@@ -175,7 +188,7 @@ void VisualOdometry::refine_keyframe_depths(const Frame& f) {
   // A keyframe that knew no depths as it was made (the first one, after a blank wall) takes them
   // from a pair whose direction is less sure: their errors are alike (a direction that is off
   // stretches them all), so the lengths fitted to them keep one unit.
-  const double max_sigma = (keyframe_.made_depths.empty() ? 3.0 : 1.0) *
+  const double max_sigma = (keyframe_.made_depths.empty() ? kLooseDirectionFactor : 1.0) *
                            options_.mono_depth_max_direction_sigma;
   if (f.stereo || !r.baseline || !r.motion_covariance_valid || !(r.motion.t.norm() > 0.0) ||
       translation_direction_sigma(r) > max_sigma)
@@ -186,22 +199,34 @@ void VisualOdometry::refine_keyframe_depths(const Frame& f) {
   const PinholeCamera& c2 = f.input.camera.pinhole;
   const double sigma_n = options_.stereo_scale.point_sigma_px / c2.fx;
   // Each point triangulated in the keyframe (the pair turned around: its second camera is the
-  // keyframe). Of the pairs so far each point keeps its surest triangulation, usually the latest
-  // (the parallax grows): fusing them all would count the keyframe's own sighting, which they
-  // share, again with each pair.
+  // keyframe). A point keeps one pair's triangulation, replaced only by one at least twice as
+  // sure (fusing them all would count the keyframe's own sighting, which they share, again with
+  // each pair). Each replacement hands the pair's length on to the keyframe's unit, with its
+  // error: replaced at every frame, the hand-held room's unit wandered by 7 % over one keyframe;
+  // twice as sure, a point is replaced two or three times as its parallax grows.
+  constexpr double kSurer = 0.5;
   const RelativePose back = RelativePose(r.motion.R, r.motion.t).inverse();
+  int triangulated = 0, replaced = 0;
   for (size_t i = 0; i < m.points.size() && i < f.point_ids.size(); ++i) {
     if (i >= inliers.size() || !inliers[i]) continue;
     const int64_t id = f.point_ids[i];
     const InverseDepth d = triangulate_inverse_depth(back.R, back.t, c2.normalize(m.points[i].x2),
                                                      c1.normalize(m.points[i].x1), sigma_n);
     if (!d.ok) continue;
+    ++triangulated;
     const auto best = keyframe_.pair_depths.find(id);
-    if (best != keyframe_.pair_depths.end() && !(d.sigma < best->second.sigma)) continue;
+    if (best != keyframe_.pair_depths.end() && !(d.sigma < kSurer * best->second.sigma)) continue;
+    ++replaced;
     keyframe_.pair_depths[id] = d;
     const auto made = keyframe_.made_depths.find(id);
     keyframe_.depths[id] =
         made == keyframe_.made_depths.end() ? d : fuse_inverse_depths(made->second, d);
+  }
+  // The unit's log-scale takes the pair's relative length error, in the share of the points
+  // that took its length (PoseCovarianceChain: the unit's drift is the seventh state).
+  if (replaced > 0 && f.length > 0.0) {
+    keyframe_.pose_covariance(6, 6) += static_cast<double>(replaced) / triangulated *
+                                       (f.length_variance() + f.direction_variance());
   }
 }
 

@@ -35,6 +35,7 @@ void VisualOdometry::remember_window_keyframe(const Frame& f) {
   const bool linked = r.became_keyframe && !window_.empty();
   if (!linked) window_.clear();
   if (linked) {
+    k.sure = r.baseline && translation_direction_sigma(r) <= options_.mono_depth_max_direction_sigma;
     // The pose that explains the pair's points, with the length as integrated.
     const RelativePose& own = f.oriented.scale_pose;
     const double length = r.motion.t.norm();
@@ -53,6 +54,12 @@ void VisualOdometry::fit_window_scale(Frame& f) {
   if (f.stereo || options_.mono_window_keyframes < 3 || cameras < 3 || !r.baseline ||
       !(r.motion.t.norm() > 0.0) || !(f.length > 0.0))
     return;
+  // Every link's direction must be known to a few degrees, as for the depths a pair triangulates:
+  // a blank wall's (the white panels: 57 degrees) places the points anywhere, and the few points
+  // of the window then gave lengths two or three times the pair's.
+  if (translation_direction_sigma(r) > options_.mono_depth_max_direction_sigma) return;
+  for (size_t k = 1; k < window_.size(); ++k)
+    if (!window_[k].sure) return;
   // The links: the window's, then this pair's (its own pose, its length as fitted). A link
   // without a length (a keyframe turned in place) has nothing to scale and is held; the oldest
   // link is the gauge: the scale carried into the window.
@@ -109,7 +116,7 @@ void VisualOdometry::fit_window_scale(Frame& f) {
   WindowScaleOptions options;
   options.point_sigma = options_.stereo_scale.point_sigma_px / camera.fx;
   options.loss_scale = options_.stereo_scale.loss_scale;
-  options.min_tying_points = options_.stereo_scale.min_near_points;
+  options.min_tying_points = options_.mono_min_depth_points;
   const WindowScaleEstimate e = estimate_window_scales(chain, fixed, points, options);
   r.window_scale_points = e.ok ? e.inliers : 0;
   if (!e.ok) return;

@@ -239,6 +239,18 @@ void VisualOdometry::fit_scale(Frame& f) {
   const RelativePoseEstimate& est = r.estimate.estimate;
   const RelativePose& pose = f.oriented.pose;
   r.motion = pose;
+  // Without the estimator's covariance the rotation gets a blank wall's (VoOrientation::orient)
+  // and the translation's direction a radian: what its data could not fix.
+  Eigen::Matrix<double, 6, 6> unknown = Eigen::Matrix<double, 6, 6>::Zero();
+  const Eigen::Vector3d u = pose.t.normalized();
+  if (all_finite(u))
+    unknown.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() - u * u.transpose();
+  // A blank wall's translation is as unknown as its rotation is uncertain: its points are sensor
+  // noise on a plane (the plain corridors' corners: 50-100 degrees off where the curvature
+  // claimed a few).
+  f.unit_covariance = est.covariance_valid ? est.covariance : unknown;
+  if (f.oriented.estimate.blank_wall)
+    f.unit_covariance.bottomRightCorner<3, 3>() += unknown.bottomRightCorner<3, 3>();
   double scale = options_.mono_scale, scale_sigma = 0.0;
   if (f.stereo) {
     add_current_disparities(f);
@@ -266,20 +278,8 @@ void VisualOdometry::fit_scale(Frame& f) {
     }
     r.stages.scale_ms += ms_since(scale_start);
   } else if (options_.mono_relative_scale && !fit_mono_scale(f, &scale, &scale_sigma)) {
-    scale = mono_length_without_depths(f);
+    scale = mono_length_without_depths(f, &scale_sigma);
   }
-  // Without the estimator's covariance the rotation gets a blank wall's (VoOrientation::orient)
-  // and the translation's direction a radian: what its data could not fix.
-  Eigen::Matrix<double, 6, 6> unknown = Eigen::Matrix<double, 6, 6>::Zero();
-  const Eigen::Vector3d u = pose.t.normalized();
-  if (all_finite(u))
-    unknown.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() - u * u.transpose();
-  // A blank wall's translation is as unknown as its rotation is uncertain: its points are sensor
-  // noise on a plane (the plain corridors' corners: 50-100 degrees off where the curvature
-  // claimed a few).
-  f.unit_covariance = est.covariance_valid ? est.covariance : unknown;
-  if (f.oriented.estimate.blank_wall)
-    f.unit_covariance.bottomRightCorner<3, 3>() += unknown.bottomRightCorner<3, 3>();
   set_length(f, scale, scale_sigma);
   if (f.stereo) prefer_stereo_translation(f);
 }

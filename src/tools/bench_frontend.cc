@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -395,6 +396,10 @@ int run(int argc, char** argv) {
   std::vector<double> pair_rot_deg, pair_dir_deg;
   // Mono pairs without a baseline whose translation the keyframe's depths measured.
   std::vector<double> depth_dir_deg, depth_dir_nees;
+  // The position from the start under the pose covariance (mono: in the unit of the first pair
+  // with a baseline, once it is known).
+  std::vector<double> position_nees;
+  double position_unit = 0.0;
   evaluation::Trajectory estimate, truth, odometry;
   // Stamps from times.txt (1 s added, as kitti_to_bag does), so that a sequence with frames left
   // out has the gaps a live camera's dropped frames leave; 10 Hz without the file.
@@ -521,6 +526,29 @@ int run(int argc, char** argv) {
               odometry.front().R, r.R_wc, gt[0].R_wc, gt[i].R_wc,
               Eigen::Matrix3d(r.pose_covariance.bottomRightCorner<3, 3>()),
               truth_orientation_sigma));
+          // The position from the start under the pose covariance's position block, the truth in
+          // the first camera's frame and, in mono, in the odometry's unit: the length of the
+          // first pair with a baseline over the truth's (so that unit's drift is what is checked).
+          const Eigen::Vector3d from_start = gt[0].R_wc.transpose() * (gt[i].c_w - gt[0].c_w);
+          const Eigen::Vector3d moved = odometry.front().R.transpose() * (r.centre - odometry.front().c);
+          if (!(position_unit > 0.0) && full && from_start.norm() > 0.0)
+            position_unit = stereo ? 1.0 : moved.norm() / from_start.norm();
+          if (position_unit > 0.0) {
+            const Eigen::Matrix3d P = r.pose_covariance.topLeftCorner<3, 3>() +
+                                      truth_position_sigma * truth_position_sigma *
+                                          position_unit * position_unit * Eigen::Matrix3d::Identity();
+            const Eigen::Vector3d e = moved - position_unit * from_start;
+            const Eigen::LDLT<Eigen::Matrix3d> ldlt(P);
+            position_nees.push_back(ldlt.info() == Eigen::Success && ldlt.isPositive() &&
+                                            ldlt.vectorD().minCoeff() > 0.0
+                                        ? e.dot(ldlt.solve(e))
+                                        : NAN);
+            if (verbose)
+              std::printf("position %d: %.4f from the start, error %.4f (%.4f along the way), "
+                          "sigma %.4f, NEES %.2f\n",
+                          i, moved.norm(), e.norm(), e.dot(from_start.normalized()),
+                          std::sqrt(P.trace()), position_nees.back());
+          }
         }
         if (!turned) pose_errors.push_back(error);
         if (verbose && (full || turned)) {
@@ -533,13 +561,21 @@ int run(int argc, char** argv) {
                    : NAN;
           std::printf("pair %d: reference %d, %s, turned %.3f deg, parallax %.2f px, rotation "
                       "error %.4f deg, NEES %.2f; direction error %.2f deg, sigma %.2f deg, NEES "
-                      "%.2f%s; %s\n",
+                      "%.2f%s; length %.4f (sigma %.4f, true %.4f; %d depth points, %d window "
+                      "points); %s\n",
                       i, reference, to_string(r.status),
                       Eigen::AngleAxisd(r.motion.R).angle() * 180.0 / M_PI, r.parallax_px,
                       pair_rot_deg.back(), pair_rot_nees.back(),
                       full ? pair_dir_deg.back() : NAN, direction_sigma,
                       full ? pair_dir_nees.back() : NAN, r.became_keyframe ? ", keyframe" : "",
-                      r.message.c_str());
+                      r.motion.t.norm(),
+                      r.motion.t.norm() > 0.0
+                          ? std::sqrt(std::max(0.0, r.motion.t.normalized().dot(
+                                                        r.motion_covariance.bottomRightCorner<3, 3>() *
+                                                        r.motion.t.normalized())))
+                          : NAN,
+                      (gt[i].c_w - gt[reference].c_w).norm(),
+                      r.mono_scale_points, r.window_scale_points, r.message.c_str());
         }
       }
     }
@@ -805,6 +841,9 @@ int run(int argc, char** argv) {
     }
     consistency("orientation against the first frame", truth_orientation_sigma, orientation_nees,
                 3, "estimated frames");
+    consistency(stereo ? "position from the start"
+                       : "position from the start, in the unit of the first pair with a baseline",
+                0.0, position_nees, 3, "estimated frames");
     if (stereo)
       consistency("metric translation per pair", 0.0, pair_t_nees, 3, "pairs with a scale");
     consistency("VP observation against the same direction's earlier one", 0.0,

@@ -77,18 +77,26 @@ struct VisualOdometryOptions {
   int min_line_matches = 12;
   // Mono: the first pair's translation has this length; later pairs take the length that
   // agrees with their keyframe's points as triangulated before (relative scale), those whose
-  // inverse depth is known to within mono_depth_max_sigma of itself; where none are, a length
-  // that goes with the parallax from the keyframe's first such pair, whose length is the last
-  // pair's speed. Every pair with a baseline refines its keyframe's depths. Without a baseline
+  // inverse depth is known to within mono_depth_max_sigma of itself; where none are, the last
+  // pair's speed (before any, a length that goes with the parallax). Every pair with a baseline
+  // refines its keyframe's depths. Without a baseline
   // the translation is measured from the keyframe's depths where it knows them, else zero within
   // mono_scale.
   double mono_scale = 1.0;
   bool mono_relative_scale = true;
   double mono_depth_max_sigma = 0.3;
+  // A length (or a translation without a baseline) from the keyframe's depths needs this many
+  // points that agree: the white panels' 20-35 gave lengths 50 % off where they claimed 3-8 %,
+  // and the last pair's speed did better (TUM structure_notexture_far, ATE over seeds 0-4: 0.054
+  // m with them, 0.035 without); a hand-held room and KITTI have 150-200.
+  int mono_min_depth_points = 40;
   // Mono: the length of the link a frame adds as it becomes the keyframe is fitted together with
   // the last links and the points tracked across them (estimation/window_scale.h), over this many
-  // keyframes, the new one included; below 3 each link keeps its pair's own length.
-  int mono_window_keyframes = 5;
+  // keyframes, the new one included; below 3 each link keeps its pair's own length. Longer
+  // windows did worse with the pairs' rotations and directions held (KITTI 01 mono, seed 0: drift
+  // 1.37 % over 3 keyframes, 1.62 over 5, 2.50 over 8, 2.84 over 12; 2.56 without): a track over
+  // many links sees their composed errors.
+  int mono_window_keyframes = 3;
   // A pair triangulates its points only when its translation's direction is this sure
   // (radians; a blank wall's is not).
   double mono_depth_max_direction_sigma = 0.05;
@@ -249,9 +257,10 @@ struct VisualOdometryResult {
   // frame (ROS's order, geometry/pose_covariance.h): the rotation block is the orientation's as
   // reported (VoOrientation::reported_covariance: the map's, with the pairs' correlated errors
   // bounded); the position is chained over the integrated pairs to first order, with its cross
-  // terms. Without a metric scale the position is in units of mono_scale per pair and knows
-  // nothing of the scale's drift. Zero at the first frame (and after a reset); a restart keeps
-  // it, as it keeps the pose.
+  // terms. Without a metric scale the position is in the unit of the first pair with a baseline
+  // (mono_scale) and holds the unit's drift: each keyframe hands its length's error on to all
+  // later ones (propagate_scaled_pose_covariance). Zero at the first frame (and after a reset); a
+  // restart keeps it, as it keeps the pose.
   Matrix6d pose_covariance = Matrix6d::Zero();
   int pose_covariance_gaps = 0;  // integrated pairs without a usable covariance, ever
   TwoViewMatches matches;        // the pair's matches (undistorted pixels) for drawing
@@ -307,8 +316,8 @@ class VisualOdometry {
     // Mono: what it knew as it became the keyframe (carried over and from its own pair), and each
     // point's surest triangulation from the pairs with it since; depths fuses the two.
     std::map<int64_t, InverseDepth> made_depths, pair_depths;
-    // Mono, while none of its points has a usable depth: its first pair with a baseline's
-    // parallax after the rotation and length (0: none yet).
+    // Mono, the first keyframe while none of its points has a usable depth: its first pair with a
+    // baseline's parallax after the rotation and length (0: none yet).
     double unit_parallax = 0.0, unit_length = 0.0;
     ImageFeatures features;                             // segments (and descriptor points)
     std::map<int64_t, LineSegment> external_lines;      // id -> segment
@@ -325,7 +334,8 @@ class VisualOdometry {
     Eigen::Matrix3d R_wc = Eigen::Matrix3d::Identity();
     Eigen::Matrix3d R_wc_covariance = Eigen::Matrix3d::Zero();  // left increment, odometry frame
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    Matrix6d pose_covariance = Matrix6d::Zero();
+    // Its pose's, with the log-scale of a mono unit (PoseCovarianceChain::scaled_covariance).
+    Matrix7d pose_covariance = Matrix7d::Zero();
     int paired_points = -1;  // point matches of the first frame paired with it
   };
 
@@ -398,9 +408,10 @@ class VisualOdometry {
   // read them (a rig of baseline 1), and those fits' options for them.
   std::vector<StereoScaleObservation> depth_observations(const Frame& f) const;
   StereoScaleOptions depth_fit_options() const;
-  // A pair with a baseline whose keyframe knows too few depths: its length from its parallax
-  // against the keyframe's first such pair's (which takes the last pair's speed, or mono_scale).
-  double mono_length_without_depths(const Frame& f);
+  // A pair with a baseline whose keyframe knows too few depths: its length from the last pair's
+  // speed, or before any from its parallax against the first such pair's (mono_scale), and its
+  // sigma (*sigma: none for the odometry's very first, which is the unit).
+  double mono_length_without_depths(const Frame& f, double* sigma);
   // A pair without a baseline: its translation from the keyframe's depths with its rotation held
   // (false: too few agree; t stays zero within mono_scale).
   bool measure_mono_translation(Frame& f) const;
@@ -485,6 +496,7 @@ class VisualOdometry {
   struct WindowKeyframe {
     std::map<int64_t, Eigen::Vector2d> rays;
     RelativePose link;
+    bool sure = false;  // the link had a baseline with a direction known to a few degrees
   };
   std::deque<WindowKeyframe> window_;
   Eigen::Matrix3d last_answer_R_wc_ = Eigen::Matrix3d::Identity();
