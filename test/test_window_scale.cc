@@ -20,12 +20,12 @@ namespace hybrid_vo {
 namespace {
 
 struct Window {
-  std::vector<RelativePose> truth;   // the links as they are
-  std::vector<RelativePose> given;   // their lengths wrong on the free links
-  std::vector<double> factor;        // truth length / given length per link
-  std::vector<WindowPoint> points;   // noiseless sightings
-  std::vector<double> rho;           // true inverse depth of each point in its anchor
-  std::vector<Eigen::Vector3d> X;    // the points in camera 0
+  std::vector<RelativePose> truth;  // the links as they are
+  std::vector<RelativePose> given;  // their lengths wrong on the free links
+  std::vector<double> factor;       // truth length / given length per link
+  std::vector<WindowPoint> points;  // noiseless sightings
+  std::vector<double> rho;          // true inverse depth of each point in its anchor
+  std::vector<Eigen::Vector3d> X;   // the points in camera 0
 };
 
 // A camera moving 0.3-1 units between keyframes, mostly ahead and sideways, turning up to 6
@@ -39,10 +39,12 @@ Window random_window(std::mt19937* rng, int links, int points, int max_span) {
   std::vector<Eigen::Matrix3d> R_c0(1, Eigen::Matrix3d::Identity());  // X_c = R_c0 X_0 + t_c0
   std::vector<Eigen::Vector3d> t_c0(1, Eigen::Vector3d::Zero());
   for (int j = 0; j < links; ++j) {
-    const Eigen::Matrix3d R = rotation_about(
-        Eigen::Vector3d(u(*rng), u(*rng), u(*rng)).normalized(), 6.0 * M_PI / 180.0 * std::abs(u(*rng)));
+    const Eigen::Matrix3d R =
+        rotation_about(Eigen::Vector3d(u(*rng), u(*rng), u(*rng)).normalized(),
+                       6.0 * M_PI / 180.0 * std::abs(u(*rng)));
     const Eigen::Vector3d t =
-        (0.65 + 0.35 * u(*rng)) * Eigen::Vector3d(0.6 * u(*rng), 0.2 * u(*rng), -1.0 + 0.3 * u(*rng)).normalized();
+        (0.65 + 0.35 * u(*rng)) *
+        Eigen::Vector3d(0.6 * u(*rng), 0.2 * u(*rng), -1.0 + 0.3 * u(*rng)).normalized();
     w.truth.emplace_back(R, t);
     const double f = j == 0 ? 1.0 : std::exp(log_error(*rng));
     w.factor.push_back(f);
@@ -168,7 +170,8 @@ TEST(WindowScale, NoisyWindowsHaveAnHonestCovariance) {
       p.x_anchor += Eigen::Vector2d(noise(rng), noise(rng));
       for (auto& s : p.seen) s.second += Eigen::Vector2d(noise(rng), noise(rng));
     }
-    const WindowScaleEstimate e = estimate_window_scales(w.given, gauge_first(links), w.points, options);
+    const WindowScaleEstimate e =
+        estimate_window_scales(w.given, gauge_first(links), w.points, options);
     if (!e.ok) continue;
     dof = links - 1;
     Eigen::VectorXd err(dof);
@@ -213,7 +216,8 @@ TEST(WindowScale, WrongMatchesDoNotMoveTheLengths) {
           wrong[i] = 1;
         }
       }
-    const WindowScaleEstimate e = estimate_window_scales(w.given, gauge_first(3), w.points, options);
+    const WindowScaleEstimate e =
+        estimate_window_scales(w.given, gauge_first(3), w.points, options);
     ASSERT_TRUE(e.ok) << k;
     for (int j = 1; j < 3; ++j) {
       const double sigma = std::sqrt(e.log_covariance(j, j));
@@ -233,8 +237,7 @@ TEST(WindowScale, WrongMatchesDoNotMoveTheLengths) {
 TEST(WindowScale, AllLinksFixedTriangulatesTheDepthsAcrossTheWindow) {
   std::mt19937 rng(6);
   const Window w = random_window(&rng, 3, 100, 3);
-  const WindowScaleEstimate e =
-      estimate_window_scales(w.truth, std::vector<char>(3, 1), w.points);
+  const WindowScaleEstimate e = estimate_window_scales(w.truth, std::vector<char>(3, 1), w.points);
   ASSERT_TRUE(e.ok);
   int checked = 0;
   for (size_t i = 0; i < w.points.size(); ++i) {

@@ -12,6 +12,13 @@
 namespace hybrid_vo {
 namespace {
 
+// The free log-scales' vectors and matrices, sized at run time up to kMaxFreeLinks without an
+// allocation (the window is solved once per keyframe; allocating per residual row was most of
+// its cost).
+using VectorF = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxFreeLinks, 1>;
+using MatrixF = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxFreeLinks, kMaxFreeLinks>;
+using Matrix3F = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, kMaxFreeLinks>;
+
 double cauchy_cost(double chi2, double k) { return k * k * std::log1p(chi2 / (k * k)); }
 double cauchy_weight(double chi2, double k) { return 1.0 / (1.0 + chi2 / (k * k)); }
 
@@ -40,7 +47,7 @@ struct State {
 struct PointRows {
   std::vector<double> r;
   std::vector<Eigen::Vector3d> j_point;
-  std::vector<Eigen::VectorXd> j;
+  std::vector<VectorF> j;
   double chi2 = 0.0;
 };
 
@@ -48,6 +55,25 @@ class WindowModel {
  public:
   WindowModel(const Chain& chain, const std::vector<WindowPoint>& points, double sigma)
       : chain_(chain), points_(points), k_(1.0 / sigma) {}
+
+  // The point's squared whitened residual norm alone (what a step's cost needs); false as rows().
+  bool chi2(const State& x, size_t i, double* out) const {
+    const WindowPoint& point = points_[i];
+    const Eigen::Vector3d& q = x.point[i];
+    const Eigen::Vector3d n =
+        chain_.Q[point.anchor].transpose() * Eigen::Vector3d(q.x(), q.y(), 1.0);
+    double sum = (q.head<2>() - point.x_anchor).squaredNorm();
+    for (const auto& [camera, x_seen] : point.seen) {
+      Eigen::Vector3d d = Eigen::Vector3d::Zero();
+      for (int link = point.anchor; link < camera; ++link)
+        d += std::exp(x.log_s(link)) * chain_.w[link];
+      const Eigen::Vector3d P = chain_.Q[camera] * (n + q.z() * d);
+      if (!(P.z() > 1e-9 * (1.0 + std::abs(P.x()) + std::abs(P.y())))) return false;
+      sum += (P.head<2>() / P.z() - x_seen).squaredNorm();
+    }
+    *out = k_ * k_ * sum;
+    return true;
+  }
 
   // False when a sighting falls behind its camera (or at infinity before it).
   bool rows(const State& x, size_t i, PointRows* p) const {
@@ -60,12 +86,13 @@ class WindowModel {
     p->j_point.clear();
     p->j.clear();
     p->chi2 = 0.0;
-    const Eigen::VectorXd none = Eigen::VectorXd::Zero(chain_.free);
+    const VectorF none = VectorF::Zero(chain_.free);
     add(p, k_ * (q.x() - point.x_anchor.x()), Eigen::Vector3d(k_, 0.0, 0.0), none);
     add(p, k_ * (q.y() - point.x_anchor.y()), Eigen::Vector3d(0.0, k_, 0.0), none);
     for (const auto& [camera, x_seen] : point.seen) {
       Eigen::Vector3d d = Eigen::Vector3d::Zero();
-      for (int link = point.anchor; link < camera; ++link) d += std::exp(x.log_s(link)) * chain_.w[link];
+      for (int link = point.anchor; link < camera; ++link)
+        d += std::exp(x.log_s(link)) * chain_.w[link];
       const Eigen::Matrix3d& Q = chain_.Q[camera];
       const Eigen::Vector3d P = Q * (n + rho * d);
       if (!(P.z() > 1e-9 * (1.0 + std::abs(P.x()) + std::abs(P.y())))) return false;
@@ -76,7 +103,7 @@ class WindowModel {
       dP_q.col(0) = Q * Qa.transpose().col(0);
       dP_q.col(1) = Q * Qa.transpose().col(1);
       dP_q.col(2) = Q * d;
-      Eigen::Matrix<double, 3, Eigen::Dynamic> dP_s = Eigen::MatrixXd::Zero(3, chain_.free);
+      Matrix3F dP_s = Matrix3F::Zero(3, chain_.free);
       for (int link = point.anchor; link < camera; ++link)
         if (chain_.free_index[link] >= 0)
           dP_s.col(chain_.free_index[link]) = rho * std::exp(x.log_s(link)) * (Q * chain_.w[link]);
@@ -87,7 +114,8 @@ class WindowModel {
   }
 
  private:
-  static void add(PointRows* p, double r, const Eigen::Vector3d& j_point, const Eigen::VectorXd& j) {
+  static void add(PointRows* p, double r, const Eigen::Vector3d& j_point,
+                  const VectorF& j) {
     p->r.push_back(r);
     p->j_point.push_back(j_point);
     p->j.push_back(j);
@@ -103,7 +131,8 @@ bool valid_input(const std::vector<RelativePose>& links, const std::vector<char>
                  const std::vector<WindowPoint>& points, const WindowScaleOptions& options) {
   const int L = static_cast<int>(links.size());
   if (L == 0 || static_cast<int>(fixed.size()) != L ||
-      std::none_of(fixed.begin(), fixed.end(), [](char f) { return f != 0; }))
+      std::none_of(fixed.begin(), fixed.end(), [](char f) { return f != 0; }) ||
+      std::count(fixed.begin(), fixed.end(), 0) > kMaxFreeLinks)
     return false;
   if (!(options.point_sigma > 0.0) || !(options.loss_scale > 0.0) || !(options.max_log_sigma > 0.0))
     return false;
@@ -130,7 +159,8 @@ double start_inverse_depth(const Chain& chain, const WindowPoint& p) {
     const RelativePose to_camera(chain.Q[camera] * chain.Q[p.anchor].transpose(),
                                  chain.Q[camera] * d);
     const RelativePose back = to_camera.inverse();
-    const InverseDepth depth = triangulate_inverse_depth(back.R, back.t, it->second, p.x_anchor, 1e-3);
+    const InverseDepth depth =
+        triangulate_inverse_depth(back.R, back.t, it->second, p.x_anchor, 1e-3);
     if (depth.ok) return depth.rho;
   }
   return 0.0;
@@ -186,11 +216,10 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
   // A sighting behind its camera costs as a gross outlier would.
   const double behind_cost = cauchy_cost(1e6 * k * k, k);
   auto cost_of = [&](const State& s) {
-    double cost = 0.0;
-    PointRows p;
+    double cost = 0.0, chi2 = 0.0;
     for (size_t i = 0; i < n; ++i) {
       if (!used[i]) continue;
-      cost += model.rows(s, i, &p) ? cauchy_cost(p.chi2, k) : behind_cost;
+      cost += model.chi2(s, i, &chi2) ? cauchy_cost(chi2, k) : behind_cost;
     }
     return cost;
   };
@@ -198,17 +227,16 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
   // Gauss-Newton on (log-scales, q_1..n) with every point eliminated by its Schur complement:
   // a point's normal equations [H_qq H_qs; H_sq H_ss] add H_ss - H_sq H_qq^-1 H_qs to the
   // reduced system (F x F). The point's Cauchy weight is refreshed each step (IRLS).
-  using Matrix3Xd = Eigen::Matrix<double, 3, Eigen::Dynamic>;
   std::vector<Eigen::Matrix3d> h_qq_inv(n, Eigen::Matrix3d::Zero());
   std::vector<Eigen::Vector3d> b_q(n, Eigen::Vector3d::Zero());
-  std::vector<Matrix3Xd> h_qs(n, Matrix3Xd::Zero(3, F));
+  std::vector<Matrix3F> h_qs(n, Matrix3F::Zero(3, F));
   std::vector<double> weight(n, 0.0);
-  Eigen::MatrixXd H(F, F);
+  MatrixF H(F, F);
   double weighted_chi2 = 0.0;
   int rows = 0, points_in = 0;
-  auto linearise = [&]() -> Eigen::VectorXd {
+  auto linearise = [&]() -> VectorF {
     H.setZero();
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(F);
+    VectorF b = VectorF::Zero(F);
     weighted_chi2 = 0.0;
     rows = points_in = 0;
     PointRows p;
@@ -220,9 +248,9 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
       if (!used[i] || !model.rows(x, i, &p)) continue;
       Eigen::Matrix3d qq = Eigen::Matrix3d::Zero();
       Eigen::Vector3d bq = Eigen::Vector3d::Zero();
-      Matrix3Xd qs = Matrix3Xd::Zero(3, F);
-      Eigen::VectorXd bs = Eigen::VectorXd::Zero(F);
-      Eigen::MatrixXd ss = Eigen::MatrixXd::Zero(F, F);
+      Matrix3F qs = Matrix3F::Zero(3, F);
+      VectorF bs = VectorF::Zero(F);
+      MatrixF ss = MatrixF::Zero(F, F);
       for (size_t row = 0; row < p.r.size(); ++row) {
         qq += p.j_point[row] * p.j_point[row].transpose();
         bq += p.j_point[row] * p.r[row];
@@ -230,9 +258,11 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
         ss += p.j[row] * p.j[row].transpose();
         bs += p.j[row] * p.r[row];
       }
-      // Its depth must move its sightings: without parallax it says nothing.
+      // Its depth must move its sightings: without parallax it says nothing, and a point whose
+      // own system is nearly singular (a wrong sighting on a short baseline) would leave the
+      // reduced one indefinite by round-off.
       const Eigen::LDLT<Eigen::Matrix3d> ldlt(qq);
-      if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * qq.trace()))
+      if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-9 * qq.trace()))
         continue;
       const Eigen::Matrix3d qq_inv = ldlt.solve(Eigen::Matrix3d::Identity());
       const double w = cauchy_weight(p.chi2, k);
@@ -246,11 +276,11 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
       rows += static_cast<int>(p.r.size());
       ++points_in;
     }
-    if (F == 0) return Eigen::VectorXd();
+    if (F == 0) return VectorF();
     return -H.ldlt().solve(b);
   };
   // The point's step follows the scales' (the weight cancels in it).
-  auto apply = [&](const Eigen::VectorXd& step, double lambda, State* to) {
+  auto apply = [&](const VectorF& step, double lambda, State* to) {
     to->log_s = x.log_s;
     for (int j = 0; j < L; ++j)
       if (chain.free_index[j] >= 0) to->log_s(j) += lambda * step(chain.free_index[j]);
@@ -258,7 +288,8 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
     for (size_t i = 0; i < n; ++i) {
       to->point[i] = x.point[i];
       if (!used[i]) continue;
-      const Eigen::Vector3d coupling = F > 0 ? Eigen::Vector3d(h_qs[i] * step) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d coupling =
+          F > 0 ? Eigen::Vector3d(h_qs[i] * step) : Eigen::Vector3d::Zero();
       to->point[i] -= lambda * h_qq_inv[i] * (b_q[i] + coupling);
       to->point[i].z() = std::max(0.0, to->point[i].z());
     }
@@ -267,7 +298,7 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
   double cost = cost_of(x);
   State trial;
   for (result.iterations = 0; result.iterations < options.max_iterations; ++result.iterations) {
-    const Eigen::VectorXd step = linearise();
+    const VectorF step = linearise();
     if (points_in == 0 || (F > 0 && !all_finite(step))) break;
     double lambda = 1.0, trial_cost = cost;
     for (int halvings = 0; halvings < 20; ++halvings, lambda *= 0.5) {
@@ -279,25 +310,28 @@ WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& link
     double moved = 0.0;
     for (size_t i = 0; i < n; ++i)
       if (used[i])
-        moved = std::max(moved, std::abs(trial.point[i].z() - x.point[i].z()) / (x.point[i].z() + 1e-12));
+        moved = std::max(moved,
+                         std::abs(trial.point[i].z() - x.point[i].z()) / (x.point[i].z() + 1e-12));
     const double scale_moved = F > 0 ? lambda * step.cwiseAbs().maxCoeff() : 0.0;
     std::swap(x, trial);
     cost = trial_cost;
-    if (scale_moved < 1e-10 && moved < 1e-9) break;
+    // A millionth of the scale, a hundred-thousandth of a depth: far below their noise.
+    if (scale_moved < 1e-6 && moved < 1e-5) break;
   }
   linearise();
   if (points_in == 0) return result;
-  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(F, F);
+  MatrixF covariance = MatrixF::Zero(F, F);
   // Residual variance over the model's: rows minus three per point and the free scales.
   const int redundancy = rows - 3 * points_in - F;
   result.variance_factor = redundancy > 0 ? weighted_chi2 / redundancy : 1.0;
   if (F > 0) {
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
+    const Eigen::LDLT<MatrixF> ldlt(H);
     if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return result;
-    covariance = result.variance_factor * ldlt.solve(Eigen::MatrixXd::Identity(F, F));
+    covariance = result.variance_factor * ldlt.solve(MatrixF::Identity(F, F));
     if (!all_finite(covariance) || !all_finite(x.log_s)) return result;
     for (int f = 0; f < F; ++f)
-      if (!(covariance(f, f) > 0.0) || covariance(f, f) > options.max_log_sigma * options.max_log_sigma)
+      if (!(covariance(f, f) > 0.0) ||
+          covariance(f, f) > options.max_log_sigma * options.max_log_sigma)
         return result;
   }
 

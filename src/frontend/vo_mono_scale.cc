@@ -101,8 +101,10 @@ bool VisualOdometry::fit_mono_scale(Frame& f, double* scale, double* sigma) cons
   // A direction that is not known to several degrees (a blank wall's: 57 degrees on the white
   // panels) fits any length to the depths: 17 times the last pair's there, where the truth had
   // 1.5; the caller's fallback, the last pair's speed, is surer.
-  const double direction = std::sqrt(std::max(0.0, f.unit_covariance.bottomRightCorner<3, 3>().trace()));
-  if (!(direction <= kLooseDirectionFactor * options_.mono_depth_max_direction_sigma)) return false;
+  const double direction =
+      std::sqrt(std::max(0.0, f.unit_covariance.bottomRightCorner<3, 3>().trace()));
+  if (!(direction <= kLooseDirectionFactor * options_.mono_depth_max_direction_sigma))
+    return false;
   const std::vector<StereoScaleObservation> observations = depth_observations(f);
   const PinholeCamera& c1 = keyframe_.camera.pinhole;
   const StereoRig rig{c1.fx, c1.fy, 1.0};

@@ -35,7 +35,8 @@ void VisualOdometry::remember_window_keyframe(const Frame& f) {
   const bool linked = r.became_keyframe && !window_.empty();
   if (!linked) window_.clear();
   if (linked) {
-    k.sure = r.baseline && translation_direction_sigma(r) <= options_.mono_depth_max_direction_sigma;
+    k.sure =
+        r.baseline && translation_direction_sigma(r) <= options_.mono_depth_max_direction_sigma;
     // The pose that explains the pair's points, with the length as integrated.
     const RelativePose& own = f.oriented.scale_pose;
     const double length = r.motion.t.norm();
@@ -82,7 +83,8 @@ void VisualOdometry::fit_window_scale(Frame& f) {
   const std::vector<char>& inliers = r.estimate.estimate.point_inliers;
   const PinholeCamera& camera = f.input.camera.pinhole;
   for (size_t i = 0; i < m.points.size() && i < f.point_ids.size(); ++i)
-    if (i < inliers.size() && inliers[i]) current[f.point_ids[i]] = camera.normalize(m.points[i].x2);
+    if (i < inliers.size() && inliers[i])
+      current[f.point_ids[i]] = camera.normalize(m.points[i].x2);
   // Every point seen across two links or more: a point seen by two cameras only fixes its own
   // depth. Each is anchored where the window first saw it.
   std::map<int64_t, WindowPoint> by_id;

@@ -48,20 +48,22 @@ struct WindowScaleOptions {
 
 struct WindowScaleEstimate {
   bool ok = false;
-  std::vector<double> scales;        // per link, the factor on its given t (1 for a fixed link)
-  Eigen::MatrixXd log_covariance;    // of the links' log-scales (fixed links: zero rows/columns)
-  std::vector<double> rho;           // per point, in its anchor camera (0: left out)
-  std::vector<double> rho_sigma;     // its standard deviation (infinite: left out)
-  std::vector<char> inlier;          // per point: Cauchy weight above 1/2 at the end
+  std::vector<double> scales;      // per link, the factor on its given t (1 for a fixed link)
+  Eigen::MatrixXd log_covariance;  // of the links' log-scales (fixed links: zero rows/columns)
+  std::vector<double> rho;         // per point, in its anchor camera (0: left out)
+  std::vector<double> rho_sigma;   // its standard deviation (infinite: left out)
+  std::vector<char> inlier;        // per point: Cauchy weight above 1/2 at the end
   int points_used = 0, inliers = 0, iterations = 0;
-  double variance_factor = 1.0;      // weighted residual variance over the modelled one
+  double variance_factor = 1.0;  // weighted residual variance over the modelled one
 };
+
+constexpr int kMaxFreeLinks = 16;
 
 // Cameras 0..L along a chain of L links: camera j+1 sees X_{j+1} = R_j X_j + s_j t_j, with
 // links[j] = (R_j, t_j). fixed[j] holds s_j at 1; at least one link must be fixed. Not ok (and
 // nothing estimated) when an input is not finite, a point's cameras are out of order or out of
-// range, no link is fixed, a free link has fewer than min_tying_points tying points or ends less
-// sure than max_log_sigma, or the fit diverges. Points that cannot be triangulated (along the
+// range, no link is fixed or more than kMaxFreeLinks are free, a free link has fewer than
+// min_tying_points tying points or ends less sure than max_log_sigma, or the fit diverges. Points that cannot be triangulated (along the
 // translation, behind a camera) are left out.
 WindowScaleEstimate estimate_window_scales(const std::vector<RelativePose>& links,
                                            const std::vector<char>& fixed,
