@@ -86,10 +86,8 @@ struct VisualOdometryOptions {
   bool mono_relative_scale = true;
   double mono_depth_max_sigma = 0.3;
   // A length (or a translation without a baseline) from the keyframe's depths needs this many
-  // points that agree: the white panels' 20-35 gave lengths 50 % off where they claimed 3-8 %,
-  // and the last pair's speed did better (TUM structure_notexture_far, ATE over seeds 0-4: 0.054
-  // m with them, 0.035 without); a hand-held room and KITTI have 150-200.
-  int mono_min_depth_points = 40;
+  // points that agree (and most of those it has).
+  int mono_min_depth_points = 10;
   // Mono: the length of the link a frame adds as it becomes the keyframe is fitted together with
   // the last links and the points tracked across them (estimation/window_scale.h), over this many
   // keyframes, the new one included; below 3 each link keeps its pair's own length. Longer
