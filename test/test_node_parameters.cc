@@ -113,6 +113,7 @@ std::vector<Case> every_parameter() {
       {"rotation_calibration_sigma", 0.02,
        [](P p) { return p.odometry.rotation_calibration_sigma == 0.02; }},
       {"mono_scale", 0.5, [](P p) { return p.odometry.mono_scale == 0.5; }},
+      {"mono_window_keyframes", 0, [](P p) { return p.odometry.mono_window_keyframes == 0; }},
       {"stereo_max_depth_baselines", 60.0,
        [](P p) { return p.odometry.stereo_scale.max_depth_baselines == 60.0; }},
       {"stereo_offset_calibration", false, [](P p) { return !p.odometry.stereo_offset.enabled; }},

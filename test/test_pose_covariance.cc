@@ -268,6 +268,127 @@ TEST(PoseCovariance, ChainKeepsTheLastOnNonFiniteInputAndCountsIt) {
   EXPECT_EQ(chain.gaps(), 4);
 }
 
+// A monocular chain whose unit drifts: each pair's translation is taken in its keyframe's unit
+// (e^s times its own), and a pair that hands the unit on leaves the next keyframe's unit off by its
+// own length error. The covariance of [position, rotation, log-scale] against Monte-Carlo runs.
+TEST(PoseCovariance, ScaledChainMatchesMonteCarlo) {
+  using Matrix7d = Eigen::Matrix<double, 7, 7>;
+  using Vector7d = Eigen::Matrix<double, 7, 1>;
+  for (uint64_t seed = 1; seed <= 3; ++seed) {
+    std::mt19937_64 rng(seed);
+    const int steps = 8, samples = 20000;
+    Matrix7d start = Matrix7d::Zero();
+    start.topLeftCorner<6, 6>() = random_covariance(rng, 1e-3, 1e-2);
+    start(6, 6) = 1e-4;
+    std::vector<Pair> pairs(steps);
+    std::vector<char> hands_on(steps);
+    Matrix7d analytic = start;
+    Eigen::Matrix3d R_wc = exp_so3(normal3(rng, 0.5));
+    const Eigen::Matrix3d R_wc0 = R_wc;
+    for (int k = 0; k < steps; ++k) {
+      Pair& p = pairs[k];
+      p.R = exp_so3(normal3(rng, 0.15));
+      p.t = normal3(rng);
+      p.covariance = random_covariance(rng, 2e-3, 2e-2);
+      hands_on[k] = k % 3 != 2;
+      R_wc = R_wc * p.R.transpose();
+      const Eigen::Matrix3d predicted = analytic.block<3, 3>(3, 3) +
+                                        R_wc * p.covariance.topLeftCorner<3, 3>() * R_wc.transpose();
+      Matrix7d next;
+      ASSERT_TRUE(propagate_scaled_pose_covariance(analytic, R_wc, p.t, p.covariance, predicted,
+                                                   hands_on[k], &next));
+      analytic = next;
+    }
+    const Sampler<7> start_error(start);
+    std::vector<Sampler<6>> pair_error;
+    for (const Pair& p : pairs) pair_error.emplace_back(p.covariance);
+    std::vector<Vector7d> errors;
+    for (int n = 0; n < samples; ++n) {
+      const Vector7d e0 = start_error(rng);
+      Eigen::Vector3d c = e0.head<3>(), c_true = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d R = exp_so3(e0.segment<3>(3)) * R_wc0, R_true = R_wc0;
+      double s = e0(6);
+      for (int k = 0; k < steps; ++k) {
+        const Pair& p = pairs[k];
+        const Vector6d noise = pair_error[k](rng);
+        const Eigen::Vector3d t_pair = p.t + noise.tail<3>();
+        R_true = R_true * p.R.transpose();
+        R = R * (exp_so3(noise.head<3>()) * p.R).transpose();
+        c = c - R * t_pair * std::exp(s);
+        c_true = c_true - R_true * p.t;
+        if (hands_on[k]) s += std::log(t_pair.norm() / p.t.norm());
+      }
+      Vector7d e;
+      e << c - c_true, log_so3(R * R_true.transpose()), s;
+      errors.push_back(e);
+    }
+    Vector7d mean = Vector7d::Zero();
+    for (const Vector7d& e : errors) mean += e;
+    mean /= samples;
+    Matrix7d sample = Matrix7d::Zero();
+    for (const Vector7d& e : errors) sample += (e - mean) * (e - mean).transpose();
+    sample /= samples - 1;
+    double worst = 0.0;
+    for (int i = 0; i < 7; ++i)
+      for (int j = 0; j < 7; ++j)
+        worst = std::max(worst, std::abs(sample(i, j) - analytic(i, j)) /
+                                    std::sqrt(analytic(i, i) * analytic(j, j)));
+    EXPECT_LT(worst, 0.05) << "seed " << seed;
+    // The unit's drift is most of the position's uncertainty here: without it the chain claims
+    // less.
+    Matrix7d exact_unit = start;
+    exact_unit(6, 6) = 0.0;
+    R_wc = R_wc0;
+    for (int k = 0; k < steps; ++k) {
+      R_wc = R_wc * pairs[k].R.transpose();
+      const Eigen::Matrix3d predicted =
+          exact_unit.block<3, 3>(3, 3) +
+          R_wc * pairs[k].covariance.topLeftCorner<3, 3>() * R_wc.transpose();
+      ASSERT_TRUE(propagate_scaled_pose_covariance(exact_unit, R_wc, pairs[k].t,
+                                                   pairs[k].covariance, predicted, false,
+                                                   &exact_unit));
+    }
+    const double with_drift = analytic.topLeftCorner<3, 3>().trace();
+    const double without = exact_unit.topLeftCorner<3, 3>().trace();
+    EXPECT_GT(with_drift, 1.5 * without) << "seed " << seed;
+  }
+}
+
+// With an exact unit and nothing handed on, the seventh state stays exact (the 6x6 chain, which
+// propagate_pose_covariance is, matches Monte Carlo above); handed on, it takes the pair's relative
+// length error.
+TEST(PoseCovariance, TheUnitTakesOnlyWhatIsHandedOn) {
+  std::mt19937_64 rng(8);
+  const Matrix6d keyframe = random_covariance(rng, 1e-3, 1e-2);
+  const Matrix6d pair = random_covariance(rng, 2e-3, 2e-2);
+  const Eigen::Matrix3d R_wc = exp_so3(normal3(rng));
+  const Eigen::Vector3d t = normal3(rng);
+  // The filter keeps the chain's prediction.
+  const Eigen::Matrix3d orientation =
+      keyframe.bottomRightCorner<3, 3>() + R_wc * pair.topLeftCorner<3, 3>() * R_wc.transpose();
+  Eigen::Matrix<double, 7, 7> scaled = Eigen::Matrix<double, 7, 7>::Zero(), out;
+  scaled.topLeftCorner<6, 6>() = keyframe;
+  ASSERT_TRUE(propagate_scaled_pose_covariance(scaled, R_wc, t, pair, orientation, false, &out));
+  EXPECT_EQ(out.row(6).norm(), 0.0);
+  // u^T C_t u / |t|^2, and the position's error along t goes with it: the position moves by
+  // -R_wc dt - [R_wc t]x R_wc theta.
+  ASSERT_TRUE(propagate_scaled_pose_covariance(scaled, R_wc, t, pair, orientation, true, &out));
+  const Eigen::Vector3d u = t.normalized();
+  EXPECT_NEAR(out(6, 6), u.dot(pair.bottomRightCorner<3, 3>() * u) / t.squaredNorm(),
+              1e-12 * out(6, 6));
+  Eigen::Matrix3d L;
+  const Eigen::Vector3d Rt = R_wc * t;
+  L << 0.0, -Rt.z(), Rt.y(), Rt.z(), 0.0, -Rt.x(), -Rt.y(), Rt.x(), 0.0;
+  const Eigen::Vector3d cross = (-R_wc * pair.bottomRightCorner<3, 3>() -
+                                 L * R_wc * pair.topRightCorner<3, 3>()) * u / t.norm();
+  EXPECT_LT((out.block<3, 1>(0, 6) - cross).norm(), 1e-9 * cross.norm());
+  // Not finite: refused, the output untouched.
+  Eigen::Matrix<double, 7, 7> bad = scaled, kept = Eigen::Matrix<double, 7, 7>::Constant(2.0);
+  bad(6, 6) = NAN;
+  EXPECT_FALSE(propagate_scaled_pose_covariance(bad, R_wc, t, pair, orientation, true, &kept));
+  EXPECT_EQ(kept, (Eigen::Matrix<double, 7, 7>::Constant(2.0)));
+}
+
 // The body's pose T_bc T_wc T_bc^-1 of perturbed camera poses.
 TEST(PoseCovariance, BodyPoseMatchesMonteCarlo) {
   for (uint64_t seed = 1; seed <= 3; ++seed) {

@@ -70,6 +70,7 @@ void VisualOdometry::restart() {
   keyframe_ = Keyframe();
   last_answer_stamp_ = -1e300;
   mono_speed_ = -1.0;
+  window_.clear();
 }
 
 VisualOdometryResult VisualOdometry::process(const VisualOdometryInput& input) {
@@ -117,7 +118,11 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   if (f.rotation_only || !f.baseline) measure_stereo_motion(f);
   orient(f);
   fit_scale(f);
-  if (keeps_keyframe(f)) return answer_without_keyframe(f);
+  if (keeps_keyframe(f)) {
+    refine_keyframe_depths(f);
+    return answer_without_keyframe(f);
+  }
+  fit_window_scale(f);
   integrate(f);
   return keep_as_keyframe(f);
 }
@@ -181,9 +186,13 @@ void VisualOdometry::integrate(Frame& f) {
   centre_ = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
   r.R_wc = orientation_.R_wc();
   r.centre = centre_;
+  // A mono keyframe made by a pair with a baseline triangulates its depths with that pair's
+  // length: its error is the unit's from now on.
   pose_covariance_.integrate(keyframe_.pose_covariance, r.R_wc, r.motion.t,
                              r.motion_covariance_valid ? &r.motion_covariance : nullptr,
-                             orientation_.reported_covariance());
+                             orientation_.reported_covariance(), !f.stereo && r.baseline);
+  // Its length's error is in the integration (along t); its direction's stretches the depths.
+  if (!f.stereo && r.baseline) pose_covariance_.add_unit_variance(f.direction_variance());
   r.pose_covariance = pose_covariance_.covariance();
   r.pose_covariance_gaps = pose_covariance_.gaps();
   r.became_keyframe = true;
@@ -201,11 +210,12 @@ VisualOdometryResult VisualOdometry::answer_without_keyframe(Frame& f) {
   r.centre = keyframe_.centre - keyframe_.R_wc * r.motion.R.transpose() * r.motion.t;
   // As integrate() would report them, without taking the pair on.
   const Eigen::Matrix3d orientation = orientation_.reported_covariance(f.oriented, motion_rotation);
-  r.pose_covariance = keyframe_.pose_covariance;
+  Matrix7d scaled = keyframe_.pose_covariance;
   if (!(r.motion_covariance_valid &&
-        propagate_pose_covariance(keyframe_.pose_covariance, r.R_wc, r.motion.t,
-                                  r.motion_covariance, orientation, &r.pose_covariance)))
-    r.pose_covariance.bottomRightCorner<3, 3>() = orientation;
+        propagate_scaled_pose_covariance(keyframe_.pose_covariance, r.R_wc, r.motion.t,
+                                         r.motion_covariance, orientation, false, &scaled)))
+    scaled.block<3, 3>(3, 3) = orientation;
+  r.pose_covariance = scaled.topLeftCorner<6, 6>();
   r.pose_covariance_gaps = pose_covariance_.gaps();
   // The rate since the last answered frame, for the segments' motion in the next one: from a
   // rotation alone, which is exact to hundredths of a degree; a full pair's without a baseline

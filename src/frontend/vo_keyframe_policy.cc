@@ -80,6 +80,7 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
   const VisualOdometryInput& input = f.input;
   std::map<int64_t, InverseDepth> depths = keyframe_depths(f);
   keyframe_ = Keyframe();
+  keyframe_.made_depths = depths;
   keyframe_.depths = std::move(depths);
   keyframe_.valid = true;
   keyframe_.stamp = input.stamp;
@@ -97,7 +98,7 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
   keyframe_.R_wc = orientation_.R_wc();
   keyframe_.R_wc_covariance = orientation_.covariance();
   keyframe_.centre = centre_;
-  keyframe_.pose_covariance = pose_covariance_.covariance();
+  keyframe_.pose_covariance = pose_covariance_.scaled_covariance();
   keyframe_.paired_points = -1;
   last_answer_stamp_ = input.stamp;
   last_answer_R_wc_ = keyframe_.R_wc;
@@ -106,6 +107,7 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
       keyframe_.external_lines[input.external.line_ids[i]] = input.external.lines[i];
   keyframe_.points_undistorted = input.external.has_points && input.external.points_undistorted;
   keyframe_.lines_undistorted = input.external.has_lines && input.external.lines_undistorted;
+  remember_window_keyframe(f);
 }
 
 }  // namespace hybrid_vo

@@ -223,6 +223,8 @@ void VisualOdometry::fit_translation_without_baseline(Frame& f) {
       r.stereo_scale.sigma = std::sqrt(std::max(0.0, m.covariance.bottomRightCorner<3, 3>().trace()));
       r.scale_known = true;
     }
+  } else if (options_.mono_relative_scale) {
+    measure_mono_translation(f);  // from the keyframe's depths, where it knows them
   }
   r.motion_covariance.topLeftCorner<3, 3>() += f.oriented.motion_rotation_extra;
 }
@@ -237,6 +239,18 @@ void VisualOdometry::fit_scale(Frame& f) {
   const RelativePoseEstimate& est = r.estimate.estimate;
   const RelativePose& pose = f.oriented.pose;
   r.motion = pose;
+  // Without the estimator's covariance the rotation gets a blank wall's (VoOrientation::orient)
+  // and the translation's direction a radian: what its data could not fix.
+  Eigen::Matrix<double, 6, 6> unknown = Eigen::Matrix<double, 6, 6>::Zero();
+  const Eigen::Vector3d u = pose.t.normalized();
+  if (all_finite(u))
+    unknown.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() - u * u.transpose();
+  // A blank wall's translation is as unknown as its rotation is uncertain: its points are sensor
+  // noise on a plane (the plain corridors' corners: 50-100 degrees off where the curvature
+  // claimed a few).
+  f.unit_covariance = est.covariance_valid ? est.covariance : unknown;
+  if (f.oriented.estimate.blank_wall)
+    f.unit_covariance.bottomRightCorner<3, 3>() += unknown.bottomRightCorner<3, 3>();
   double scale = options_.mono_scale, scale_sigma = 0.0;
   if (f.stereo) {
     add_current_disparities(f);
@@ -263,27 +277,22 @@ void VisualOdometry::fit_scale(Frame& f) {
       r.scale_known = true;
     }
     r.stages.scale_ms += ms_since(scale_start);
-  } else if (options_.mono_relative_scale) {
-    const double dt = f.input.stamp - keyframe_.stamp;
-    if (!fit_mono_scale(f, &scale, &scale_sigma) && mono_speed_ > 0.0 && dt > 0.0)
-      scale = mono_speed_ * dt;
+  } else if (options_.mono_relative_scale && !fit_mono_scale(f, &scale, &scale_sigma)) {
+    scale = mono_length_without_depths(f, &scale_sigma);
   }
+  set_length(f, scale, scale_sigma);
+  if (f.stereo) prefer_stereo_translation(f);
+}
+
+void VisualOdometry::set_length(Frame& f, double scale, double sigma) {
+  VisualOdometryResult& r = f.result;
+  const RelativePose& pose = f.oriented.pose;
   r.motion.t = pose.t * scale;
-  // Without the estimator's covariance the rotation gets a blank wall's (VoOrientation::orient)
-  // and the translation's direction a radian: what its data could not fix.
-  Eigen::Matrix<double, 6, 6> unknown = Eigen::Matrix<double, 6, 6>::Zero();
-  const Eigen::Vector3d u = pose.t.normalized();
-  if (all_finite(u))
-    unknown.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() - u * u.transpose();
-  // A blank wall's translation is as unknown as its rotation is uncertain: its points are sensor
-  // noise on a plane (the plain corridors' corners: 50-100 degrees off where the curvature
-  // claimed a few).
-  Eigen::Matrix<double, 6, 6> unit = est.covariance_valid ? est.covariance : unknown;
-  if (f.oriented.estimate.blank_wall) unit.bottomRightCorner<3, 3>() += unknown.bottomRightCorner<3, 3>();
-  r.motion_covariance = metric_motion_covariance(unit, pose.t, scale, scale_sigma);
+  r.motion_covariance = metric_motion_covariance(f.unit_covariance, pose.t, scale, sigma);
   r.motion_covariance.topLeftCorner<3, 3>() += f.oriented.motion_rotation_extra;
   r.motion_covariance_valid = true;
-  if (f.stereo) prefer_stereo_translation(f);
+  f.length = scale;
+  f.length_sigma = sigma;
 }
 
 void VisualOdometry::prefer_stereo_translation(Frame& f) {

@@ -63,48 +63,77 @@ Eigen::Matrix3d left_jacobian_inverse(const Eigen::Vector3d& phi) {
 
 }  // namespace
 
-bool propagate_pose_covariance(const Matrix6d& keyframe, const Eigen::Matrix3d& R_wc,
-                               const Eigen::Vector3d& t, const Matrix6d& motion_covariance,
-                               const Eigen::Matrix3d& orientation_covariance, Matrix6d* out) {
+bool propagate_scaled_pose_covariance(const Matrix7d& keyframe, const Eigen::Matrix3d& R_wc,
+                                      const Eigen::Vector3d& t, const Matrix6d& motion_covariance,
+                                      const Eigen::Matrix3d& orientation_covariance,
+                                      bool hands_on, Matrix7d* out) {
   if (!keyframe.allFinite() || !R_wc.allFinite() || !t.allFinite() ||
       !motion_covariance.allFinite() || !orientation_covariance.allFinite())
     return false;
-  // The errors: the keyframe's (position c, rotation phi), the pair's (theta, dt) and the filter's
-  // own w. The chain predicts phi_p = phi - R_wc theta; the filter holds phi' = M phi_p + w;
-  // centre = c - R_wc t moves by [R_wc t]x phi' - R_wc dt.
-  const Eigen::Matrix3d predicted = keyframe.bottomRightCorner<3, 3>() +
+  // The errors: the keyframe's (position c, rotation phi, log-scale s), the pair's (theta, dt)
+  // and the filter's own w. The chain predicts phi_p = phi - R_wc theta; the filter holds
+  // phi' = M phi_p + w; centre = c - R_wc t e^s moves by [R_wc t]x phi' - R_wc dt - R_wc t s; a
+  // pair that hands the unit on leaves s' = s + u^T dt / |t| (u = t / |t|), else s' = s.
+  const Eigen::Matrix3d predicted = keyframe.block<3, 3>(3, 3) +
                                     R_wc * motion_covariance.topLeftCorner<3, 3>() *
                                         R_wc.transpose();
   Eigen::Matrix3d M, W;
   filter_step(predicted, orientation_covariance, &M, &W);
   const Eigen::Matrix3d L = skew(R_wc * t);
-  Eigen::Matrix<double, 6, 15> J = Eigen::Matrix<double, 6, 15>::Zero();
+  // Columns: c (0), phi (3), s (6), theta (7), dt (10), w (13).
+  Eigen::Matrix<double, 7, 16> J = Eigen::Matrix<double, 7, 16>::Zero();
   J.block<3, 3>(0, 0).setIdentity();
   J.block<3, 3>(0, 3) = L * M;
-  J.block<3, 3>(0, 6) = -L * M * R_wc;
-  J.block<3, 3>(0, 9) = -R_wc;
-  J.block<3, 3>(0, 12) = L;
+  J.block<3, 1>(0, 6) = -R_wc * t;
+  J.block<3, 3>(0, 7) = -L * M * R_wc;
+  J.block<3, 3>(0, 10) = -R_wc;
+  J.block<3, 3>(0, 13) = L;
   J.block<3, 3>(3, 3) = M;
-  J.block<3, 3>(3, 6) = -M * R_wc;
-  J.block<3, 3>(3, 12).setIdentity();
-  Eigen::Matrix<double, 15, 15> Z = Eigen::Matrix<double, 15, 15>::Zero();
-  Z.block<6, 6>(0, 0) = keyframe;
-  Z.block<6, 6>(6, 6) = motion_covariance;
-  Z.block<3, 3>(12, 12) = W;
-  const Matrix6d result = symmetric<6>(J * Z * J.transpose());
+  J.block<3, 3>(3, 7) = -M * R_wc;
+  J.block<3, 3>(3, 13).setIdentity();
+  J(6, 6) = 1.0;
+  const double length = t.norm();
+  if (hands_on && length > 0.0) J.block<1, 3>(6, 10) = t.transpose() / (length * length);
+  Eigen::Matrix<double, 16, 16> Z = Eigen::Matrix<double, 16, 16>::Zero();
+  Z.block<7, 7>(0, 0) = keyframe;
+  Z.block<6, 6>(7, 7) = motion_covariance;
+  Z.block<3, 3>(13, 13) = W;
+  const Matrix7d result = symmetric<7>(J * Z * J.transpose());
   if (!result.allFinite()) return false;
   *out = result;
   return true;
 }
 
+bool propagate_pose_covariance(const Matrix6d& keyframe, const Eigen::Matrix3d& R_wc,
+                               const Eigen::Vector3d& t, const Matrix6d& motion_covariance,
+                               const Eigen::Matrix3d& orientation_covariance, Matrix6d* out) {
+  Matrix7d scaled = Matrix7d::Zero(), result;
+  scaled.topLeftCorner<6, 6>() = keyframe;
+  if (!propagate_scaled_pose_covariance(scaled, R_wc, t, motion_covariance,
+                                        orientation_covariance, false, &result))
+    return false;
+  *out = result.topLeftCorner<6, 6>();
+  return true;
+}
+
+void PoseCovarianceChain::integrate(const Matrix7d& keyframe, const Eigen::Matrix3d& R_wc,
+                                    const Eigen::Vector3d& t, const Matrix6d* motion_covariance,
+                                    const Eigen::Matrix3d& orientation_covariance,
+                                    bool hands_on) {
+  if (!motion_covariance) ++gaps_;
+  const Matrix6d pair = motion_covariance ? *motion_covariance : Matrix6d::Zero();
+  if (propagate_scaled_pose_covariance(keyframe, R_wc, t, pair, orientation_covariance,
+                                       hands_on && motion_covariance, &covariance_))
+    return;
+  if (motion_covariance) ++gaps_;  // the last covariance stays
+}
+
 void PoseCovarianceChain::integrate(const Matrix6d& keyframe, const Eigen::Matrix3d& R_wc,
                                     const Eigen::Vector3d& t, const Matrix6d* motion_covariance,
                                     const Eigen::Matrix3d& orientation_covariance) {
-  if (!motion_covariance) ++gaps_;
-  const Matrix6d pair = motion_covariance ? *motion_covariance : Matrix6d::Zero();
-  if (propagate_pose_covariance(keyframe, R_wc, t, pair, orientation_covariance, &covariance_))
-    return;
-  if (motion_covariance) ++gaps_;  // the last covariance stays
+  Matrix7d scaled = Matrix7d::Zero();
+  scaled.topLeftCorner<6, 6>() = keyframe;
+  integrate(scaled, R_wc, t, motion_covariance, orientation_covariance, false);
 }
 
 Matrix6d body_pose_covariance(const Matrix6d& camera, const Eigen::Matrix3d& R_wc,

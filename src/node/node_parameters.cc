@@ -166,6 +166,7 @@ const std::vector<Parameter>& parameters() {
       field<double>("rotation_calibration_sigma",
                     NODE_FIELD(double, odometry.rotation_calibration_sigma)),
       field<double>("mono_scale", NODE_FIELD(double, odometry.mono_scale)),
+      field<int>("mono_window_keyframes", NODE_FIELD(int, odometry.mono_window_keyframes)),
       field<double>("stereo_max_depth_baselines",
                     NODE_FIELD(double, odometry.stereo_scale.max_depth_baselines)),
       field<bool>("stereo_offset_calibration", NODE_FIELD(bool, odometry.stereo_offset.enabled)),

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -49,7 +50,7 @@ void usage(const char* program) {
                " [--truth-orientation-sigma-deg S] [--truth-position-sigma-m S]"
                " [--max-cpu-ms B] [--work-level L]"
                " [--max-features N] [--redetect-alternate] [--rotation-calibration-sigma S]"
-               " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]"
+               " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P] [--mono-window K]"
                " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
                " [--independent-translation-points N]\n"
                "       [--stereo-translation-margin M] [--verbose]\n"
@@ -103,7 +104,9 @@ void usage(const char* program) {
                "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
                "  (rotation_only_pairs: false); --rotation-keyframe-overlap F: the node's\n"
                "  keyframe_overlap; --keyframe-parallax P: keyframe_parallax_px (0: every frame\n"
-               "  with a baseline becomes the keyframe). --stereo-translation-margin M: a stereo pair takes\n"
+               "  with a baseline becomes the keyframe). --mono-window K: mono_window_keyframes (a new\n"
+               "  keyframe link's length fitted with the last links over K keyframes; < 3: off).\n"
+               "  --stereo-translation-margin M: a stereo pair takes\n"
                "  the stereo points' translation where its covariance is M times smaller (0:\n"
                "  never; default 2).\n";
 }
@@ -271,6 +274,8 @@ int run(int argc, char** argv) {
       o.orientation.map.min_direction_sigma_deg = std::atof(argv[++i]);
     else if (a == "--keyframe-parallax" && i + 1 < argc)
       o.keyframe_parallax_px = std::atof(argv[++i]);
+    else if (a == "--mono-window" && i + 1 < argc)
+      o.mono_window_keyframes = std::atoi(argv[++i]);
     else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
@@ -389,6 +394,12 @@ int run(int argc, char** argv) {
   // The rotation and translation direction errors of the estimated pairs (status OK), as
   // hybrid_vo_eval_trajectory takes them from the node's MotionEstimate messages.
   std::vector<double> pair_rot_deg, pair_dir_deg;
+  // Mono pairs without a baseline whose translation the keyframe's depths measured.
+  std::vector<double> depth_dir_deg, depth_dir_nees;
+  // The position from the start under the pose covariance (mono: in the unit of the first pair
+  // with a baseline, once it is known).
+  std::vector<double> position_nees;
+  double position_unit = 0.0;
   evaluation::Trajectory estimate, truth, odometry;
   // Stamps from times.txt (1 s added, as kitti_to_bag does), so that a sequence with frames left
   // out has the gaps a live camera's dropped frames leave; 10 Hz without the file.
@@ -415,7 +426,7 @@ int run(int argc, char** argv) {
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
   // Keyframes, and the answered frames a second after the first and those of them with a baseline.
-  int keyframes = 1, late_answers = 0, late_baselines = 0;
+  int keyframes = 1, late_answers = 0, late_baselines = 0, late_translations = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
   evaluation::DirectionSightings vp_sightings;  // the VP observations' NEES (2 dof)
   double farthest = 0.0;             // of the position from the first frame's
@@ -483,6 +494,14 @@ int run(int argc, char** argv) {
                             std::hypot(truth_direction_sigma, position_part))
                       : NAN);
           }
+          if (!full && r.translation_from_depths && truth_pose.t.norm() > 0.0) {
+            depth_dir_deg.push_back(translation_error(r.motion.t, truth_pose.t) * 180.0 / M_PI);
+            depth_dir_nees.push_back(
+                valid ? evaluation::direction_nees(r.motion.t, truth_pose.t,
+                                                   C.bottomRightCorner<3, 3>(),
+                                                   truth_direction_sigma)
+                      : NAN);
+          }
           if (r.scale_known) {
             pair_t_nees.push_back(valid ? evaluation::translation_nees(
                                               r.motion.t, truth_pose.t, C.bottomRightCorner<3, 3>())
@@ -507,6 +526,29 @@ int run(int argc, char** argv) {
               odometry.front().R, r.R_wc, gt[0].R_wc, gt[i].R_wc,
               Eigen::Matrix3d(r.pose_covariance.bottomRightCorner<3, 3>()),
               truth_orientation_sigma));
+          // The position from the start under the pose covariance's position block, the truth in
+          // the first camera's frame and, in mono, in the odometry's unit: the length of the
+          // first pair with a baseline over the truth's (so that unit's drift is what is checked).
+          const Eigen::Vector3d from_start = gt[0].R_wc.transpose() * (gt[i].c_w - gt[0].c_w);
+          const Eigen::Vector3d moved = odometry.front().R.transpose() * (r.centre - odometry.front().c);
+          if (!(position_unit > 0.0) && full && from_start.norm() > 0.0)
+            position_unit = stereo ? 1.0 : moved.norm() / from_start.norm();
+          if (position_unit > 0.0) {
+            const Eigen::Matrix3d P = r.pose_covariance.topLeftCorner<3, 3>() +
+                                      truth_position_sigma * truth_position_sigma *
+                                          position_unit * position_unit * Eigen::Matrix3d::Identity();
+            const Eigen::Vector3d e = moved - position_unit * from_start;
+            const Eigen::LDLT<Eigen::Matrix3d> ldlt(P);
+            position_nees.push_back(ldlt.info() == Eigen::Success && ldlt.isPositive() &&
+                                            ldlt.vectorD().minCoeff() > 0.0
+                                        ? e.dot(ldlt.solve(e))
+                                        : NAN);
+            if (verbose)
+              std::printf("position %d: %.4f from the start, error %.4f (%.4f along the way), "
+                          "sigma %.4f, NEES %.2f\n",
+                          i, moved.norm(), e.norm(), e.dot(from_start.normalized()),
+                          std::sqrt(P.trace()), position_nees.back());
+          }
         }
         if (!turned) pose_errors.push_back(error);
         if (verbose && (full || turned)) {
@@ -519,13 +561,21 @@ int run(int argc, char** argv) {
                    : NAN;
           std::printf("pair %d: reference %d, %s, turned %.3f deg, parallax %.2f px, rotation "
                       "error %.4f deg, NEES %.2f; direction error %.2f deg, sigma %.2f deg, NEES "
-                      "%.2f%s; %s\n",
+                      "%.2f%s; length %.4f (sigma %.4f, true %.4f; %d depth points, %d window "
+                      "points); %s\n",
                       i, reference, to_string(r.status),
                       Eigen::AngleAxisd(r.motion.R).angle() * 180.0 / M_PI, r.parallax_px,
                       pair_rot_deg.back(), pair_rot_nees.back(),
                       full ? pair_dir_deg.back() : NAN, direction_sigma,
                       full ? pair_dir_nees.back() : NAN, r.became_keyframe ? ", keyframe" : "",
-                      r.message.c_str());
+                      r.motion.t.norm(),
+                      r.motion.t.norm() > 0.0
+                          ? std::sqrt(std::max(0.0, r.motion.t.normalized().dot(
+                                                        r.motion_covariance.bottomRightCorner<3, 3>() *
+                                                        r.motion.t.normalized())))
+                          : NAN,
+                      (gt[i].c_w - gt[reference].c_w).norm(),
+                      r.mono_scale_points, r.window_scale_points, r.message.c_str());
         }
       }
     }
@@ -649,6 +699,11 @@ int run(int argc, char** argv) {
     if (answered(r.status) && input.stamp - stamps[0] >= 1.0) {
       ++late_answers;
       late_baselines += r.baseline;
+      // Its translation measured: by a baseline, or without one by the keyframe's depths (mono)
+      // or stereo points.
+      late_translations += r.baseline || r.translation_from_depths ||
+                           ((r.status == VoStatus::kOk || r.status == VoStatus::kRotationOnly) &&
+                            r.scale_known);
     }
     farthest = std::max(farthest, (r.centre - odometry.front().c).norm());
     rotation_only += r.status == VoStatus::kRotationOnly;
@@ -685,9 +740,11 @@ int run(int argc, char** argv) {
               frames > 1 ? 100.0 * answered_frames / (frames - 1) : 0.0, rotation_only, farthest,
               stereo ? "m" : "per-pair units");
   std::printf("# keyframes: %d of %d frames; after the first second %d of %d answered frames have "
-              "a baseline (%.1f %%)\n",
+              "a baseline (%.1f %%), %d a measured translation (%.1f %%: with a baseline, or "
+              "without one from the keyframe's depths or stereo points)\n",
               keyframes, frames, late_baselines, late_answers,
-              late_answers > 0 ? 100.0 * late_baselines / late_answers : 0.0);
+              late_answers > 0 ? 100.0 * late_baselines / late_answers : 0.0, late_translations,
+              late_answers > 0 ? 100.0 * late_translations / late_answers : 0.0);
   {
     const KltTrackStats& t = vo.point_track_stats();
     const double per_frame = t.frames > 0 ? 1.0 / t.frames : 0.0;
@@ -775,8 +832,18 @@ int run(int argc, char** argv) {
     consistency("rotation per pair", truth_rotation_sigma, pair_rot_nees, 3, "estimated pairs");
     consistency("translation direction per pair", truth_direction_sigma, pair_dir_nees, 2,
                 "estimated pairs");
+    if (!depth_dir_nees.empty()) {
+      std::printf("median direction error of the translations without a baseline (from the "
+                  "keyframe's depths) %.2f deg\n",
+                  median(depth_dir_deg));
+      consistency("translation direction without a baseline, from the keyframe's depths",
+                  truth_direction_sigma, depth_dir_nees, 2, "pairs");
+    }
     consistency("orientation against the first frame", truth_orientation_sigma, orientation_nees,
                 3, "estimated frames");
+    consistency(stereo ? "position from the start"
+                       : "position from the start, in the unit of the first pair with a baseline",
+                0.0, position_nees, 3, "estimated frames");
     if (stereo)
       consistency("metric translation per pair", 0.0, pair_t_nees, 3, "pairs with a scale");
     consistency("VP observation against the same direction's earlier one", 0.0,

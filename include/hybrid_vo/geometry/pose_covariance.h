@@ -1,5 +1,7 @@
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 
 namespace hybrid_vo {
@@ -26,23 +28,47 @@ bool propagate_pose_covariance(const Matrix6d& keyframe, const Eigen::Matrix3d& 
                                const Eigen::Vector3d& t, const Matrix6d& motion_covariance,
                                const Eigen::Matrix3d& orientation_covariance, Matrix6d* out);
 
-// The pose covariance as an odometry integrates its pairs (what VisualOdometry keeps): zero at the
-// origin, which is exact by definition.
+// A monocular odometry's unit drifts (issue 58): it is the first pair's length, and each keyframe
+// hands it on through the depths it triangulates with its own pair's length, so that an error of
+// that length stays in every later one (Strasdat, Montiel and Davison, "Scale drift-aware large
+// scale monocular SLAM", RSS 2010). Its log is a seventh state after the pose's six, [position,
+// rotation, log-scale of the unit]: every pair's translation scales with its keyframe's unit (the
+// position moves by -R_wc t per unit of it), and a pair that hands the unit on (`hands_on`: a
+// keyframe made by a pair whose length was fitted) adds its own relative length error, the part of
+// its translation's error along t over |t|, to it. Without hands_on and with a log-scale known
+// exactly (stereo: every pair's length is metric) this is propagate_pose_covariance.
+using Matrix7d = Eigen::Matrix<double, 7, 7>;
+bool propagate_scaled_pose_covariance(const Matrix7d& keyframe, const Eigen::Matrix3d& R_wc,
+                                      const Eigen::Vector3d& t, const Matrix6d& motion_covariance,
+                                      const Eigen::Matrix3d& orientation_covariance,
+                                      bool hands_on, Matrix7d* out);
+
+// The pose covariance as an odometry integrates its pairs (what VisualOdometry keeps), with the
+// log-scale of a monocular unit (above): zero at the origin, which is exact by definition.
 class PoseCovarianceChain {
  public:
-  const Matrix6d& covariance() const { return covariance_; }
+  Matrix6d covariance() const { return covariance_.topLeftCorner<6, 6>(); }
+  const Matrix7d& scaled_covariance() const { return covariance_; }
   // Integrated pairs whose covariance was missing (the position then grew by the orientation's
   // uncertainty alone) or whose inputs were not finite (the last covariance kept).
   int gaps() const { return gaps_; }
-  // One pair integrated onto the keyframe's covariance (propagate_pose_covariance);
-  // motion_covariance null when the pair has none.
+  // One pair integrated onto the keyframe's covariance (propagate_scaled_pose_covariance);
+  // motion_covariance null when the pair has none. A keyframe's 6x6 covariance has an exact unit.
+  void integrate(const Matrix7d& keyframe, const Eigen::Matrix3d& R_wc, const Eigen::Vector3d& t,
+                 const Matrix6d* motion_covariance,
+                 const Eigen::Matrix3d& orientation_covariance, bool hands_on = false);
   void integrate(const Matrix6d& keyframe, const Eigen::Matrix3d& R_wc, const Eigen::Vector3d& t,
                  const Matrix6d* motion_covariance,
                  const Eigen::Matrix3d& orientation_covariance);
+  // The unit's log-scale grows by this variance (what a mono keyframe hands on besides its
+  // length's error); a negative or non-finite one is ignored.
+  void add_unit_variance(double variance) {
+    if (variance > 0.0 && std::isfinite(variance)) covariance_(6, 6) += variance;
+  }
   void reset() { covariance_.setZero(); }  // the gaps stay counted
 
  private:
-  Matrix6d covariance_ = Matrix6d::Zero();
+  Matrix7d covariance_ = Matrix7d::Zero();
   int gaps_ = 0;
 };
 
