@@ -151,6 +151,12 @@ class KltTracker {
   std::vector<PointMatch> track_existing(const GrayImage& image, std::vector<int64_t>* ids = nullptr,
                                          double stamp = kNoStamp,
                                          const ParallelFor& parallel = {});
+  // track_existing on the pyramid of the image (build_pyramid), built by the caller so that it
+  // serves the frame's other stages too (segments, stereo): one pyramid per frame.
+  std::vector<cv::Mat> build_pyramid(const GrayImage& image) const;
+  std::vector<PointMatch> track_pyramid(std::vector<cv::Mat> pyramid,
+                                        std::vector<int64_t>* ids = nullptr,
+                                        double stamp = kNoStamp, const ParallelFor& parallel = {});
   // Fills the buckets of the last tracked image that have too few features; appends to points().
   void detect_new(const ParallelFor& parallel = {});
   // detect_new in three steps, so that a caller can run the cells beside other work: the grid,
