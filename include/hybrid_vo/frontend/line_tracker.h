@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "hybrid_vo/frontend/line_matching.h"
+#include "hybrid_vo/frontend/segment_motion.h"
 
 namespace hybrid_vo {
 
@@ -81,16 +82,10 @@ class LineTracker {
     LineSegment segment;  // where it was last seen (oriented), or predicted while it coasts
     cv::Mat descriptor;   // its LBD row when last seen, or empty
     double seen_at = 0.0;  // the time of `segment`
-    // Image motion per unit of time beyond the camera's rotation: the shift of the line along its
-    // normal at the midpoint and the turn of its direction; unknown until seen twice.
-    bool has_motion = false;
-    Eigen::Vector2d shift = Eigen::Vector2d::Zero();
-    double turn = 0.0;
+    // Image motion per unit of time beyond the camera's rotation (segment_motion.h).
+    SegmentMotion motion;
     int missed = 0;  // frames in a row without a match
   };
-  // Where track t lies at time `now`, its segment first carried by `image_motion`.
-  static LineSegment predict(const Track& t, double now, const Eigen::Matrix3d& image_motion);
-
   // One frame's search (track's steps): per track its prediction, its segment carried by the
   // rotation alone and the segment it found (-1: none); per segment its track (-1: none).
   struct Search {
