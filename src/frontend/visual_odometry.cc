@@ -47,6 +47,7 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
       klt_(options.klt, options.features.points.max_features),
       line_tracker_(options.line_tracking, options.features.lines),
+      line_flow_(options.line_flow_tracking),
       orientation_(options),
       offset_filter_(options.stereo_offset),
       budget_(options.budget) {
@@ -67,6 +68,7 @@ void VisualOdometry::restart() {
   orientation_.restart();
   klt_.reset();
   line_tracker_.reset();
+  line_flow_.reset();
   keyframe_ = Keyframe();
   last_answer_stamp_ = -1e300;
   mono_speed_ = -1.0;
@@ -93,6 +95,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   // refinement. This thread tracks the points meanwhile, then estimates while the second one
   // matches the stereo points, and takes what is left of a shared stage when it needs its results.
   if (f.stereo) f.pyramids_job = worker_->submit([this, &f] { build_stereo_pyramids(f); });
+  build_pyramid(f);                        // before the segments, which may follow its flow
   if (options_.use_lines && !input.external.has_lines)
     f.segments_job = worker_->submit([this, &f] { track_segments(f); });
   track_points(f);                         // both threads (the KLT searches)

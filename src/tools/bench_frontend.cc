@@ -49,7 +49,8 @@ void usage(const char* program) {
                " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P]"
                " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
                " [--independent-translation-points N]\n"
-               "       [--stereo-translation-margin M] [--verbose]\n"
+               "       [--stereo-translation-margin M] [--line-flow | --no-line-flow]\n"
+               "       [--line-redetect-below F] [--line-detect-every N] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
@@ -96,7 +97,11 @@ void usage(const char* program) {
                "  keyframe_overlap; --keyframe-parallax P: keyframe_parallax_px (0: every frame\n"
                "  with a baseline becomes the keyframe). --stereo-translation-margin M: a stereo pair takes\n"
                "  the stereo points' translation where its covariance is M times smaller (0:\n"
-               "  never; default 2).\n";
+               "  never; default 2).\n"
+               "  --line-flow / --no-line-flow: segments followed by their flow and detected only\n"
+               "  where their tracks thin out (line_flow), or detected and described every frame;\n"
+               "  --line-redetect-below F, --line-detect-every N: when the flow's tracks are\n"
+               "  detected again (below F of the last detection's tracks, or N frames after it).\n";
 }
 
 // The median of each coordinate.
@@ -192,6 +197,12 @@ int run(int argc, char** argv) {
     else if (a == "--preset" && i + 1 < argc) preset = argv[++i];
     else if (a == "--sequential") o.concurrent = false;
     else if (a == "--lbd") o.track_lines = false;
+    else if (a == "--line-flow") o.line_flow = true;
+    else if (a == "--no-line-flow") o.line_flow = false;
+    else if (a == "--line-redetect-below" && i + 1 < argc)
+      o.line_flow_tracking.redetect_below = std::atof(argv[++i]);
+    else if (a == "--line-detect-every" && i + 1 < argc)
+      o.line_flow_tracking.max_frames_between_detections = std::atoi(argv[++i]);
     else if (a == "--min-corner-gradient" && i + 1 < argc)
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--min-corner-isotropy" && i + 1 < argc)
@@ -357,6 +368,7 @@ int run(int argc, char** argv) {
       stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
+  int segment_detections = 0;  // frames whose segments were detected
   // Keyframes, and the answered frames a second after the first and those of them with a baseline.
   int keyframes = 1, late_answers = 0, late_baselines = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
@@ -375,6 +387,7 @@ int run(int argc, char** argv) {
     if (stereo) input.right_image = right_images[i];
     const double cpu_start = cpu_ms();
     const VisualOdometryResult r = vo.process(input);
+    segment_detections += r.line_tracking.detected;
     {
       evaluation::StampedPose p;
       p.stamp = input.stamp;
@@ -680,6 +693,7 @@ int run(int argc, char** argv) {
               "found %.0f, started %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
               median(line_matches), median(line_inliers), median(tracked), median(started),
               lines_sum > 0.0 ? inliers_sum / lines_sum : 0.0, lines_sum);
+  std::printf("segments detected in %d of %d frames\n", segment_detections, frames);
   std::printf("median per estimated frame: junctions %.0f (%.0f inliers), VPs %.0f (%.0f "
               "inliers)\n",
               median(junctions), median(junction_inliers), median(vp_matches),

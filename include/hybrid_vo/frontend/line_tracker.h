@@ -50,7 +50,8 @@ struct LineTrackingStats {
   int ambiguous = 0;  // of those, told apart by the descriptor
   int reidentified = 0;  // of those, found by descriptor matching after the search
   int started = 0;    // new tracks from this frame's unmatched segments
-  int dropped = 0;    // tracks missed for more than max_missed_frames
+  int dropped = 0;    // tracks missed for more than max_missed_frames (line flow: lost, merged)
+  bool detected = false;  // the frame's segments were detected (line flow: where tracks thin out)
 };
 
 class LineTracker {

@@ -13,6 +13,7 @@
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/cpu_budget.h"
 #include "hybrid_vo/frontend/klt_tracker.h"
+#include "hybrid_vo/frontend/line_flow_tracker.h"
 #include "hybrid_vo/frontend/line_tracker.h"
 #include "hybrid_vo/frontend/stage_timings.h"
 #include "hybrid_vo/estimation/rotation_only.h"
@@ -44,6 +45,11 @@ struct VisualOdometryOptions {
   // keyframe's by track id; false: the keyframe's segments matched by LBD in every frame.
   bool track_lines = true;
   LineTrackerOptions line_tracking;
+  // With track_lines: the segments followed from frame to frame by their flow and detected only
+  // where their tracks thin out (LineFlowTracker, issue 57); false: detected and described in
+  // every frame and tracked by their geometry (LineTracker).
+  bool line_flow = false;
+  LineFlowTrackerOptions line_flow_tracking;
   // The segments and the stereo matching on a second thread, beside the points and the
   // estimator. The results do not depend on it.
   bool concurrent = true;
@@ -337,6 +343,9 @@ class VisualOdometry {
 
   // vo_tracking.cc: the frame's points and segments, their matches with the keyframe's, and the
   // KLT re-detection for the next frame.
+  // The frame's image pyramid, which the KLT tracker, the segments' flow and the stereo
+  // matching share (built when one of them needs it).
+  void build_pyramid(Frame& f) const;
   void track_segments(Frame& f);      // detected, described and tracked (the second thread)
   void track_points(Frame& f);        // KLT (searches on both threads), external or descriptors
   void match_points(Frame& f) const;  // with the keyframe's, and the parallax
@@ -425,6 +434,7 @@ class VisualOdometry {
   std::unique_ptr<WorkerThread> worker_;
   KltTracker klt_;
   LineTracker line_tracker_;
+  LineFlowTracker line_flow_;
   VoOrientation orientation_;
   // Kept across reset(): the offset belongs to the rig, not to the trajectory.
   DisparityOffsetFilter offset_filter_;
