@@ -151,11 +151,11 @@ TEST(SegmentFlow, SegmentsMovedByAHomographyLandOnTheirTrueLines) {
       EXPECT_LT(line_error(flows[k].segment, truth), 0.2) << "segment " << k;
       // p1 and p2 keep their roles, and the ends stay near the true ones.
       EXPECT_GT((flows[k].segment.p2 - flows[k].segment.p1).dot(truth.p2 - truth.p1), 0.0);
-      // The ends are where the edge ends, when the prediction along it is within the ends'
-      // search (without one, the sides slid 10-15 px along themselves).
+      // The ends are where the edge ends, up to the prediction's error along it (4.2 px here;
+      // without a prediction the sides slid 10-15 px along themselves).
       if (shift > 0.0) {
-        EXPECT_LT((flows[k].segment.p1 - truth.p1).norm(), 3.0) << "segment " << k;
-        EXPECT_LT((flows[k].segment.p2 - truth.p2).norm(), 3.0) << "segment " << k;
+        EXPECT_LT((flows[k].segment.p1 - truth.p1).norm(), 5.0) << "segment " << k;
+        EXPECT_LT((flows[k].segment.p2 - truth.p2).norm(), 5.0) << "segment " << k;
       }
       EXPECT_GE(flows[k].inliers, flows[k].samples * 3 / 4);
       EXPECT_LT(flows[k].rms_px, 0.3);
@@ -216,7 +216,7 @@ TEST(LineFlowTracker, KeepsIdsAlongTheFlowAndAsksForTheDetectorWhenTracksThinOut
   for (int frame = 1; frame <= 3; ++frame) {
     H = motion(0.7, 4.0, 2.5) * H;
     LineTrackingStats stats;
-    tracker.track(levels(render(scene, H)), 1.0 + 0.1 * frame, Eigen::Matrix3d::Identity(),
+    tracker.track(levels(render(scene, H)), 1.0 + 0.1 * frame, Eigen::Matrix3d::Identity(), nullptr, {},
                   &stats);
     EXPECT_EQ(stats.matched, static_cast<int>(scene.segments.size())) << "frame " << frame;
     EXPECT_EQ(tracker.ids(), ids);
@@ -227,7 +227,9 @@ TEST(LineFlowTracker, KeepsIdsAlongTheFlowAndAsksForTheDetectorWhenTracksThinOut
   EXPECT_FALSE(tracker.wants_detection());
 
   // A detection continues each track (the true sides, longer by a few pixels: fresh ends); a new
-  // segment starts its own.
+  // segment starts its own. The tracks keep the lines the flow measured, and reach the
+  // detections' ends.
+  const std::vector<LineSegment> followed = tracker.segments();
   std::vector<LineSegment> detected;
   for (const LineSegment& s : scene.segments) {
     const LineSegment t = apply(H, s);
@@ -239,7 +241,11 @@ TEST(LineFlowTracker, KeepsIdsAlongTheFlowAndAsksForTheDetectorWhenTracksThinOut
   EXPECT_EQ(tracker.num_tracks(), static_cast<int>(scene.segments.size()) + 1);
   const std::vector<int64_t> after = tracker.ids();
   EXPECT_TRUE(std::equal(ids.begin(), ids.end(), after.begin()));
-  EXPECT_NEAR(tracker.segments()[0].length(), detected[0].length(), 1e-9);
+  const std::vector<LineSegment> refreshed = tracker.segments();
+  for (size_t k = 0; k < followed.size(); ++k) {
+    EXPECT_LT(line_error(refreshed[k], followed[k]), 1e-6) << "segment " << k;
+    EXPECT_NEAR(refreshed[k].length(), detected[k].length(), 0.1) << "segment " << k;
+  }
 
   // The second and third quadrilaterals painted over: half the tracks are lost, and the tracker
   // wants the detector.
@@ -247,7 +253,7 @@ TEST(LineFlowTracker, KeepsIdsAlongTheFlowAndAsksForTheDetectorWhenTracksThinOut
   cv::rectangle(next, cv::Rect(330, 30, 300, 240), cv::Scalar(119), cv::FILLED);
   cv::rectangle(next, cv::Rect(60, 250, 270, 220), cv::Scalar(119), cv::FILLED);
   LineTrackingStats stats;
-  tracker.track(levels(next), 1.5, Eigen::Matrix3d::Identity(), &stats);
+  tracker.track(levels(next), 1.5, Eigen::Matrix3d::Identity(), nullptr, {}, &stats);
   EXPECT_GE(stats.dropped, 8);
   EXPECT_TRUE(tracker.wants_detection());
 }
@@ -265,6 +271,81 @@ TEST(LineFlowTracker, OneDetectionContinuingTwoTracksMergesThemIntoTheOldest) {
   // Opposite contrast (reversed direction) continues nothing: a new track.
   tracker.add_detections({LineSegment({305, 100.2}, {95, 100.2})});
   EXPECT_EQ(tracker.num_tracks(), 2);
+}
+
+// Points on a grid, each where H takes it.
+std::vector<PointMatch> grid_motion(const Eigen::Matrix3d& H, double spacing) {
+  std::vector<PointMatch> motion;
+  for (double y = 5; y < kHeight; y += spacing)
+    for (double x = 5; x < kWidth; x += spacing) {
+      PointMatch m;
+      m.x1 = Eigen::Vector2d(x, y);
+      m.x2 = apply(H, m.x1);
+      motion.push_back(m);
+    }
+  return motion;
+}
+
+TEST(PointFlowField, PredictsASegmentByThePointsAroundIt) {
+  const Eigen::Matrix3d H = motion(1.5, 14.0, -9.0);
+  const PointFlowField field(grid_motion(H, 16.0));
+  const LineSegment s({150, 200}, {400, 260});
+  LineSegment predicted;
+  double spread = -1.0;
+  ASSERT_TRUE(field.predict(s, 40.0, 4, &predicted, &spread));
+  // The field is smooth: the ends land within a pixel of where H takes them.
+  EXPECT_LT((predicted.p1 - apply(H, s.p1)).norm(), 1.0);
+  EXPECT_LT((predicted.p2 - apply(H, s.p2)).norm(), 1.0);
+  EXPECT_LT(spread, 0.5);
+  // Too few points near it, or none at all: no prediction.
+  EXPECT_FALSE(PointFlowField(grid_motion(H, 200.0)).predict(s, 10.0, 4, &predicted, &spread));
+  EXPECT_FALSE(PointFlowField().predict(s, 40.0, 4, &predicted, &spread));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(field.predict(LineSegment({nan, 0}, {1, 1}), 40.0, 4, &predicted, &spread));
+}
+
+TEST(LineFlowTracker, ThePointsCarryYoungTracksFartherThanTheirOwnReach) {
+  const Scene scene = quadrilaterals();
+  const Eigen::Matrix3d H = motion(0.5, 21.0, 0.0);
+  const std::vector<cv::Mat> first = levels(render(scene, Eigen::Matrix3d::Identity()));
+  const std::vector<cv::Mat> second = levels(render(scene, H));
+  const PointFlowField points(grid_motion(H, 16.0));
+  for (const bool with_points : {false, true}) {
+    LineFlowTracker tracker;
+    tracker.track(first, 1.0);
+    tracker.add_detections(scene.segments);
+    LineTrackingStats stats;
+    tracker.track(second, 1.1, Eigen::Matrix3d::Identity(), with_points ? &points : nullptr, {},
+                  &stats);
+    // A young track is looked for 12 px around the rotation's prediction: the sides that move
+    // 21 px across themselves are beyond it.
+    if (!with_points) {
+      EXPECT_LT(stats.matched, static_cast<int>(scene.segments.size()));
+      continue;
+    }
+    EXPECT_EQ(stats.matched, static_cast<int>(scene.segments.size()));
+    const std::vector<LineSegment> segments = tracker.segments();
+    for (size_t k = 0; k < segments.size(); ++k)
+      EXPECT_LT(line_error(segments[k], apply(H, scene.segments[k])), 0.2) << "segment " << k;
+  }
+}
+
+TEST(LineFlowTracker, NewTracksStartOnTheEdgeAsTheFlowMeasuresIt) {
+  // A detector's line a third of a pixel off the edge: the track starts on the edge itself, so
+  // that every frame of it measures the same thing.
+  const Scene scene = quadrilaterals();
+  LineFlowTracker tracker;
+  tracker.track(levels(render(scene, Eigen::Matrix3d::Identity())), 1.0);
+  std::vector<LineSegment> detected;
+  for (const LineSegment& s : scene.segments) {
+    const Eigen::Vector2d u = (s.p2 - s.p1).normalized(), n(-u.y(), u.x());
+    detected.push_back(LineSegment(s.p1 + 0.35 * n, s.p2 + 0.35 * n));
+  }
+  tracker.add_detections(detected);
+  const std::vector<LineSegment> started = tracker.segments();
+  ASSERT_EQ(started.size(), scene.segments.size());
+  for (size_t k = 0; k < started.size(); ++k)
+    EXPECT_LT(line_error(started[k], scene.segments[k]), 0.15) << "segment " << k;
 }
 
 }  // namespace

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hybrid_vo {
 namespace {
 
-// How far detected segment `d` continues track segment `t` along it (the overlap, px), or -1 when
-// it does not (LineFlowTrackerOptions' association).
+// How far detected segment `d` lies from track segment `t` that it continues (the mean distance
+// of its line to t's ends of their overlap, px), or -1 when it does not continue it
+// (LineFlowTrackerOptions' association).
 double continuation(const LineSegment& t, const LineSegment& d, double cos_angle, double offset,
                     double min_overlap) {
   const double lt = t.length(), ld = d.length();
@@ -18,10 +20,20 @@ double continuation(const LineSegment& t, const LineSegment& d, double cos_angle
   const double lo = std::max(0.0, std::min(a, b)), hi = std::min(lt, std::max(a, b));
   if (hi - lo < min_overlap * std::min(lt, ld)) return -1.0;
   const Eigen::Vector3d line = line_through(d.p1, d.p2);
-  if (std::abs(line.dot(homogeneous(t.p1 + lo * ut))) > offset ||
-      std::abs(line.dot(homogeneous(t.p1 + hi * ut))) > offset)
-    return -1.0;
-  return hi - lo;
+  const double e1 = std::abs(line.dot(homogeneous(t.p1 + lo * ut)));
+  const double e2 = std::abs(line.dot(homogeneous(t.p1 + hi * ut)));
+  if (!(e1 <= offset) || !(e2 <= offset)) return -1.0;
+  return 0.5 * (e1 + e2);
+}
+
+// Segment `t` along its own line, extended to cover `d`'s ends projected onto it.
+LineSegment spanning(const LineSegment& t, const LineSegment& d) {
+  const double length = t.length();
+  if (!(length > 0.0)) return t;
+  const Eigen::Vector2d u = (t.p2 - t.p1) / length;
+  const double lo = std::min({0.0, u.dot(d.p1 - t.p1), u.dot(d.p2 - t.p1)});
+  const double hi = std::max({length, u.dot(d.p1 - t.p1), u.dot(d.p2 - t.p1)});
+  return LineSegment(t.p1 + lo * u, t.p1 + hi * u);
 }
 
 }  // namespace
@@ -46,7 +58,8 @@ LineFlowTracker::Track LineFlowTracker::new_track(const LineSegment& segment) {
 }
 
 void LineFlowTracker::track(const std::vector<cv::Mat>& pyramid, double stamp,
-                            const Eigen::Matrix3d& image_motion, LineTrackingStats* stats) {
+                            const Eigen::Matrix3d& image_motion, const PointFlowField* points,
+                            const ParallelFor& parallel, LineTrackingStats* stats) {
   LineTrackingStats local;
   LineTrackingStats& st = stats ? *stats : local;
   st = LineTrackingStats();
@@ -65,17 +78,28 @@ void LineFlowTracker::track(const std::vector<cv::Mat>& pyramid, double stamp,
     std::vector<double> reach;
     for (const Track& t : tracks_) {
       segments.push_back(t.segment);
-      predicted.push_back(predict_segment(t.segment, t.motion, now - t.seen_at, H));
       LineSegment c;
       carried.push_back(transfer_segment(H, t.segment, &c) ? c : t.segment);
-      // The own motion's guess is uncertain by a fraction of it; the rotation's is not.
+      // By the points around it where there are some, within their spread; else by the
+      // rotation and the track's own velocity, whose guess is uncertain by a fraction of it
+      // (the rotation's is not).
+      LineSegment by_points;
+      double spread = 0.0;
+      if (points && points->predict(t.segment, options_.point_radius_px, options_.min_points,
+                                    &by_points, &spread)) {
+        predicted.push_back(by_points);
+        reach.push_back(std::min(options_.young_reach_px,
+                                 options_.min_reach_px + options_.spread_factor * spread));
+        continue;
+      }
+      predicted.push_back(predict_segment(t.segment, t.motion, now - t.seen_at, H));
       const double motion = std::max((predicted.back().p1 - carried.back().p1).norm(),
                                      (predicted.back().p2 - carried.back().p2).norm());
       reach.push_back(t.motion.known ? options_.min_reach_px + options_.motion_fraction * motion
                                      : options_.young_reach_px);
     }
-    const std::vector<SegmentFlow> flows =
-        track_segments_by_flow(previous_, pyramid, segments, predicted, reach, options_.flow);
+    const std::vector<SegmentFlow> flows = track_segments_by_flow(
+        previous_, pyramid, segments, predicted, reach, options_.flow, parallel);
     std::vector<Track> kept;
     for (size_t k = 0; k < tracks_.size(); ++k) {
       if (!flows[k].found) {
@@ -97,7 +121,8 @@ void LineFlowTracker::track(const std::vector<cv::Mat>& pyramid, double stamp,
 }
 
 bool LineFlowTracker::wants_detection() const {
-  return tracks_.empty() || frames_since_detection_ >= options_.max_frames_between_detections ||
+  return tracks_.empty() ||
+         frames_since_detection_ + 1 >= options_.max_frames_between_detections ||
          static_cast<double>(tracks_.size()) <
              options_.redetect_below * static_cast<double>(tracks_after_detection_);
 }
@@ -108,19 +133,20 @@ void LineFlowTracker::add_detections(const std::vector<LineSegment>& detected,
   LineTrackingStats& st = stats ? *stats : local;
   const int m = static_cast<int>(tracks_.size()), n = static_cast<int>(detected.size());
   const double cos_angle = std::cos(options_.associate_angle_deg * M_PI / 180.0);
-  // Each track's detection: the one continuing it furthest.
+  // Each track's detection: the nearest of those continuing it (of two parallel edges a pixel or
+  // two apart, the one the flow followed).
   std::vector<int> choice(m, -1);
   std::vector<char> continues(n, 0);
   for (int k = 0; k < m; ++k) {
-    double best = -1.0;
+    double best = std::numeric_limits<double>::infinity();
     for (int j = 0; j < n; ++j) {
-      const double overlap =
+      const double offset =
           continuation(tracks_[k].segment, detected[j], cos_angle, options_.associate_offset_px,
                        options_.associate_overlap);
-      if (overlap < 0.0) continue;
+      if (offset < 0.0) continue;
       continues[j] = 1;
-      if (overlap > best) {
-        best = overlap;
+      if (offset < best) {
+        best = offset;
         choice[k] = j;
       }
     }
@@ -135,16 +161,27 @@ void LineFlowTracker::add_detections(const std::vector<LineSegment>& detected,
       ++st.dropped;
       continue;
     }
+    // The track keeps its line: the detector's line of the same edge lies a few tenths of a
+    // pixel off the one the flow measures (their junctions' epipolar error half as large again
+    // on TartanAir's panels when a pair mixed the two); its ends reach the detection's.
     Track t = tracks_[k];
     if (j >= 0) {
       owner[j] = k;
-      t.segment = detected[j];
+      t.segment = spanning(t.segment, detected[j]);
     }
     kept.push_back(t);
   }
-  for (int j = 0; j < n; ++j) {
-    if (continues[j]) continue;
-    kept.push_back(new_track(detected[j]));
+  // New tracks start on the edge as the flow measures it, for the same reason.
+  std::vector<LineSegment> fresh;
+  for (int j = 0; j < n; ++j)
+    if (!continues[j]) fresh.push_back(detected[j]);
+  const std::vector<SegmentFlow> measured =
+      previous_.empty() ? std::vector<SegmentFlow>(fresh.size())
+                        : track_segments_by_flow(previous_, previous_, fresh, fresh,
+                                                 std::vector<double>(fresh.size(), 2.0),
+                                                 options_.flow);
+  for (size_t k = 0; k < fresh.size(); ++k) {
+    kept.push_back(new_track(measured[k].found ? measured[k].segment : fresh[k]));
     ++st.started;
   }
   tracks_ = std::move(kept);

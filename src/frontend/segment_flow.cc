@@ -71,36 +71,42 @@ Vec2 at_level(const Vec2& p, int level) {
   return Vec2((p.x() + 0.5f) * s - 0.5f, (p.y() + 0.5f) * s - 0.5f);
 }
 
-// One sample's search: its offset along the predicted normal n from its predicted place q (full
-// resolution pixels), found by the profile taken at s across the old normal m.
+// One sample's searches along the predicted normal n from its predicted place q (full
+// resolution pixels), by the profile taken at s across the old normal m.
 struct SampleSearch {
   const std::vector<cv::Mat>& from;
   const std::vector<cv::Mat>& to;
   const SegmentFlowOptions& options;
-  int levels;  // coarse levels used
 
-  // Searched up to `reach` pixels of full resolution either side of q. false: s or q outside
-  // the image (`outside` set), or not found.
-  bool run(const Vec2& s, const Vec2& m, const Vec2& q, const Vec2& n, float reach, float* offset,
-           bool* outside) const {
+  // The correlations at offsets -range..range (pixels of `level`) around q; false when the
+  // template is flat (no edge to follow).
+  bool scores(const Vec2& s, const Vec2& m, const Vec2& q, const Vec2& n, int level, int range,
+              float* out) const {
     const int h = options.profile_half_px, width = 2 * h + 1;
-    float tmpl[64], normalised[64], window[160], scores[96];
-    *outside = !inside(from[0], s) || !inside(to[0], q);
-    if (*outside) return false;
-    // The coarse search starts at the finest level whose search_px pixels cover the reach: a
-    // wider search than the prediction needs meets parallel edges of the same contrast.
-    int start = 0;
-    while (start < levels && reach > static_cast<float>(options.search_px << start)) ++start;
-    const int first_range = std::clamp(static_cast<int>(std::ceil(reach / (1 << start))), 2,
-                                       options.search_px);
-    float o = 0.0f;  // the offset found so far, in the current level's pixels
-    for (int level = start; level >= 0; --level) {
+    float tmpl[64], normalised[64], window[160];
+    profile(from[level], at_level(s, level), m, -h, width, tmpl);
+    if (!(normalise(tmpl, width, normalised) > 0.0f)) return false;
+    profile(to[level], at_level(q, level), n, -h - range, width + 2 * range, window);
+    for (int d = 0; d <= 2 * range; ++d) out[d] = correlation(normalised, window + d, width);
+    return true;
+  }
+
+  // From offset `o` (pixels of level `start`, where the segment's coarse search put the sample)
+  // down the finer levels, +-3 pixels at the first and +-2 at the next (at level 0 too when it
+  // starts there), to the edge at full resolution; false when not found.
+  bool refine(const Vec2& s, const Vec2& m, const Vec2& q, const Vec2& n, int start, float o,
+              float* offset) const {
+    const int h = options.profile_half_px, width = 2 * h + 1;
+    float tmpl[64], normalised[64], window[160], scores[8];
+    for (int level = std::max(0, start - 1); level >= 0; --level) {
+      if (level < start) o *= 2.0f;
+      // One more pixel below the coarse level, which halves its pixel and its error doubles.
+      const int range = level == start - 1 ? 3 : 2;
       profile(from[level], at_level(s, level), m, -h, width, tmpl);
       const float contrast = normalise(tmpl, width, normalised);
       if (!(contrast > 0.0f)) return false;
-      // The window spans one more pixel each side than the offsets searched (the sub-pixel
-      // interpolation's).
-      const int range = level == start ? first_range : 2;
+      // The window spans one more pixel each side than the offsets searched (the gradient
+      // peak's).
       const int count = width + 2 * range + 2;
       profile(to[level], at_level(q, level), n, o - h - range - 1, count, window);
       int best = 0;
@@ -108,36 +114,21 @@ struct SampleSearch {
         scores[d] = correlation(normalised, window + 1 + d, width);
         if (scores[d] > scores[best]) best = d;
       }
-      if (level == start) {
-        // Another edge of the same contrast within reach makes the sample ambiguous (a peak inside
-        // the search: one at its end may be the slope of the best).
-        const float rival = static_cast<float>(options.rival_ratio * (1.0 - scores[best]) +
-                                               options.rival_margin);
-        for (int d = 1; d < 2 * range; ++d) {
-          if (std::abs(d - best) < 2) continue;
-          const bool peak = scores[d] >= scores[d - 1] && scores[d] >= scores[d + 1];
-          if (peak && 1.0f - scores[d] <= rival) return false;
-        }
-      }
+      // The best within the search: one at its end would lie beyond it.
+      if (best == 0 || best == 2 * range) return false;
       o += static_cast<float>(best - range);
-      if (level > 0) {
-        o *= 2.0f;
-        continue;
-      }
-      // Full resolution: the best within the search (one at its end would lie beyond it), as
-      // alike as the template, of a like contrast (the correlation alone takes a faint edge for
-      // the strong one followed), then to a fraction of a pixel.
-      if (level < start && (best == 0 || best == 2 * range)) return false;
+      if (level > 0) continue;
+      // Full resolution: as alike as the template, of a like contrast (the correlation alone
+      // takes a faint edge for the strong one followed), then the edge itself: the extreme of
+      // the derivative across it, of the template's sign, within a pixel of where the
+      // template's centre landed, to a fraction of a pixel by a parabola. Each frame measures
+      // the edge afresh, as a detector would, instead of carrying the last frame's error on.
       if (scores[best] < options.min_correlation) return false;
       float centred[64];
       const float found_contrast = normalise(window + 1 + best, width, centred);
       if (!(found_contrast * options.max_contrast_ratio >= contrast &&
             found_contrast <= options.max_contrast_ratio * contrast))
         return false;
-      // The edge itself: the extreme of the derivative across it, of the template's sign,
-      // within a pixel of where the template's centre landed, to a fraction of a pixel by a
-      // parabola. Each frame measures the edge afresh, as a detector would, instead of
-      // carrying the last frame's error on.
       const float polarity = tmpl[h + 1] - tmpl[h - 1] >= 0.0f ? 1.0f : -1.0f;
       const int c = best + 1 + h;
       const auto derivative = [&](int j) { return polarity * (window[j + 1] - window[j - 1]); };
@@ -155,6 +146,51 @@ struct SampleSearch {
     return false;
   }
 };
+
+// The segment's coarse search: the offset across it at its middle and the change of that offset
+// from end to end (its turn) that the samples' correlations agree on best, or false when none
+// is clear. Samples alone are often ambiguous (a panel's seams, tiles: parallel edges of the
+// same contrast a few pixels apart), a whole segment seldom.
+struct CoarseFit {
+  int offset = 0;     // index into the scores (0 .. 2 range) at the segment's middle
+  double turn = 0.0;  // offset at the end minus that at the start (level pixels)
+  int at(float where) const { return offset + static_cast<int>(std::lround(turn * (where - 0.5))); }
+};
+bool coarse_fit(const std::vector<std::vector<float>>& scores, const std::vector<float>& where,
+                int range, int max_turn, const SegmentFlowOptions& o, CoarseFit* fit) {
+  const int offsets = 2 * range + 1, usable = static_cast<int>(scores.size());
+  // Per offset the best turn's mean correlation over the samples (half a pixel steps; a sample
+  // the turn takes beyond the search counts as uncorrelated, lest turns gain by dropping the
+  // samples that disagree).
+  std::vector<float> total(offsets, -2.0f);
+  std::vector<double> turn_of(offsets, 0.0);
+  for (int d = 0; d < offsets; ++d)
+    for (int half_steps = -2 * max_turn; half_steps <= 2 * max_turn; ++half_steps) {
+      CoarseFit candidate;
+      candidate.offset = d;
+      candidate.turn = 0.5 * half_steps;
+      float sum = 0.0f;
+      for (int i = 0; i < usable; ++i) {
+        const int k = candidate.at(where[i]);
+        if (k >= 0 && k < offsets) sum += scores[i][k];
+      }
+      if (sum / usable > total[d]) {
+        total[d] = sum / usable;
+        turn_of[d] = candidate.turn;
+      }
+    }
+  const int best = static_cast<int>(std::max_element(total.begin(), total.end()) - total.begin());
+  // Another peak nearly as good (inside the search: one at its end may be the best's slope).
+  const float rival = static_cast<float>(o.rival_ratio * (1.0 - total[best]) + o.rival_margin);
+  for (int d = 1; d + 1 < offsets; ++d) {
+    if (std::abs(d - best) < 2) continue;
+    if (total[d] >= total[d - 1] && total[d] >= total[d + 1] && 1.0f - total[d] <= rival)
+      return false;
+  }
+  fit->offset = best;
+  fit->turn = turn_of[best];
+  return true;
+}
 
 // A total-least-squares line through `points`: a point on it and its unit direction.
 void fit_line(const std::vector<Eigen::Vector2d>& points, Eigen::Vector2d* centre,
@@ -185,20 +221,51 @@ SegmentFlow track_one(const std::vector<cv::Mat>& from, const std::vector<cv::Ma
   const Vec2 b1 = predicted.p1.cast<float>(), b2 = predicted.p2.cast<float>();
   const Vec2 v = (a2 - a1).normalized(), m(-v.y(), v.x());
   const Vec2 u = (b2 - b1).normalized(), n(-u.y(), u.x());
-  const SampleSearch search{from, to, o, levels};
+  const SampleSearch search{from, to, o};
   const double inset_a = o.end_inset_px / length, inset_b = o.end_inset_px / predicted_length;
-  std::vector<Eigen::Vector2d> found;
+  // The coarse search starts at the finest level whose search_px pixels cover the reach: a
+  // wider search than the prediction needs meets more parallel edges of the same contrast.
+  int start = 0;
+  while (start < levels && reach > static_cast<float>(o.search_px << start)) ++start;
+  const int range =
+      std::clamp(static_cast<int>(std::ceil(reach / (1 << start))), 2, o.search_px);
+  const float scale = 1.0f / static_cast<float>(1 << start);
+  const int max_turn = std::min(
+      range, static_cast<int>(std::ceil(predicted_length * scale *
+                                        std::tan(o.coarse_turn_deg * M_PI / 180.0))));
+  std::vector<Vec2> old_at, new_at;
+  std::vector<float> where;
+  std::vector<std::vector<float>> scores;
   for (int i = 0; i < samples; ++i) {
     const double t = static_cast<double>(i) / (samples - 1);
     const float ta = static_cast<float>(inset_a + t * (1.0 - 2.0 * inset_a));
     const float tb = static_cast<float>(inset_b + t * (1.0 - 2.0 * inset_b));
     const Vec2 s = a1 + ta * (a2 - a1), q = b1 + tb * (b2 - b1);
+    if (!inside(from[0], s) || !inside(to[0], q)) continue;
+    ++flow.samples;
+    std::vector<float> sample_scores(2 * range + 1);
+    if (!search.scores(s, m, q, n, start, range, sample_scores.data())) continue;
+    old_at.push_back(s);
+    new_at.push_back(q);
+    where.push_back(static_cast<float>(t));
+    scores.push_back(std::move(sample_scores));
+  }
+  CoarseFit coarse;
+  if (static_cast<int>(scores.size()) < std::max(2, o.min_inliers) ||
+      !coarse_fit(scores, where, range, max_turn, o, &coarse))
+    return flow;
+  std::vector<Eigen::Vector2d> found;
+  for (size_t i = 0; i < old_at.size(); ++i) {
+    // The sample's own peak within a pixel of the segment's fit (the turn is coarse).
+    const std::vector<float>& own = scores[i];
+    int k = std::clamp(coarse.at(where[i]), 0, 2 * range);
+    const int fitted = k;
+    for (int j = std::max(0, fitted - 1); j <= std::min(2 * range, fitted + 1); ++j)
+      if (own[j] > own[k]) k = j;
+    const float at = static_cast<float>(k - range);
     float offset = 0.0f;
-    bool outside = false;
-    if (search.run(s, m, q, n, reach, &offset, &outside)) {
-      found.push_back((q + offset * n).cast<double>());
-    }
-    flow.samples += !outside;
+    if (search.refine(old_at[i], m, new_at[i], n, start, at, &offset))
+      found.push_back((new_at[i] + offset * n).cast<double>());
   }
   const int min_inliers = std::max(2, o.min_inliers);
   if (static_cast<int>(found.size()) < min_inliers) return flow;

@@ -96,9 +96,12 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   // matches the stereo points, and takes what is left of a shared stage when it needs its results.
   if (f.stereo) f.pyramids_job = worker_->submit([this, &f] { build_stereo_pyramids(f); });
   build_pyramid(f);                        // before the segments, which may follow its flow
-  if (options_.use_lines && !input.external.has_lines)
-    f.segments_job = worker_->submit([this, &f] { track_segments(f); });
+  const bool lines = options_.use_lines && !input.external.has_lines;
+  const bool flow = lines && options_.track_lines && options_.line_flow;
+  if (flow) start_segment_detection(f);
+  else if (lines) f.segments_job = worker_->submit([this, &f] { track_segments(f); });
   track_points(f);                         // both threads (the KLT searches)
+  if (flow) follow_segments(f);            // both threads
   match_points(f);                         // this thread, as everything not marked
   // Both threads; a skipped frame needs none, a rotation-only one its translation in stereo.
   if (!low_parallax(f) || options_.rotation_only_pairs) start_stereo(f);

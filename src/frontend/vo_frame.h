@@ -39,6 +39,12 @@ struct VisualOdometry::Frame {
   std::map<int64_t, Eigen::Vector2d> points;  // by id; the tracked ones until re-detection
   ImageFeatures features;                     // segments (and descriptor points)
   std::vector<int64_t> line_ids;              // with track_lines: the track of each segment
+  // With line_flow: the KLT tracks' motion into this frame, which predicts the segments'; and
+  // the frame's detected segments (oriented), when the tracks want them.
+  std::vector<PointMatch> point_motion;
+  bool detect_segments = false;
+  std::vector<LineSegment> detected_segments;
+  double detection_ms = 0.0;
   std::vector<int64_t> point_ids;             // per point match: its id
   // The median transfer error of the point matches under the rotation that best explains them
   // (the parallax after the rotation), or their median motion where no rotation was found;
@@ -70,7 +76,7 @@ struct VisualOdometry::Frame {
   WorkClock redetect_clock;
 
   // The second thread's work (see above).
-  WorkerJob pyramids_job, segments_job;
+  WorkerJob pyramids_job, segments_job, detection_job;
   SharedLoop stereo_loop, redetection;
 };
 

@@ -58,29 +58,43 @@ void VisualOdometry::build_pyramid(Frame& f) const {
 
 void VisualOdometry::track_segments(Frame& f) {
   const auto lines_start = std::chrono::steady_clock::now();
-  if (options_.track_lines && options_.line_flow) {
-    // The tracks follow the flow; the detector (without descriptors: nothing matches by them)
-    // runs where they thin out.
-    line_flow_.track(pyramid_images(f.pyramid), f.input.stamp, f.segment_motion,
-                     &f.result.line_tracking);
-    if (line_flow_.wants_detection()) {
-      LineDescriptionOptions oriented = segment_options_.description;
-      oriented.describe = false;
-      const LineFeatures detected = describe_line_segments(
-          f.gray, detect_line_segments(f.gray, segment_options_.detection), nullptr, oriented);
-      line_flow_.add_detections(detected.segments, &f.result.line_tracking);
-      f.result.line_tracking.detected = true;
-    }
-    f.features.lines.segments = line_flow_.segments();
-    f.line_ids = line_flow_.ids();
-  } else {
-    f.features.lines = detect_line_features(f.gray, segment_options_);
-    if (options_.track_lines)
-      f.line_ids = line_tracker_.track(f.features.lines, f.input.stamp, &f.result.line_tracking,
-                                       f.segment_motion);
+  f.features.lines = detect_line_features(f.gray, segment_options_);
+  if (options_.track_lines)
+    f.line_ids = line_tracker_.track(f.features.lines, f.input.stamp, &f.result.line_tracking,
+                                     f.segment_motion);
+  f.result.line_tracking.detected = true;
+  f.result.stages.lines_ms = ms_since(lines_start);
+}
+
+void VisualOdometry::start_segment_detection(Frame& f) {
+  // Without descriptors: the flow's tracks match nothing by them.
+  f.detect_segments = line_flow_.wants_detection();
+  if (!f.detect_segments) return;
+  f.detection_job = worker_->submit([this, &f] {
+    const auto start = std::chrono::steady_clock::now();
+    LineDescriptionOptions oriented = segment_options_.description;
+    oriented.describe = false;
+    f.detected_segments =
+        describe_line_segments(f.gray, detect_line_segments(f.gray, segment_options_.detection),
+                               nullptr, oriented)
+            .segments;
+    f.detection_ms = ms_since(start);
+  });
+}
+
+void VisualOdometry::follow_segments(Frame& f) {
+  const auto start = std::chrono::steady_clock::now();
+  const PointFlowField points(f.point_motion);
+  line_flow_.track(pyramid_images(f.pyramid), f.input.stamp, f.segment_motion, &points,
+                   worker_->parallel(), &f.result.line_tracking);
+  f.detection_job.get();
+  if (f.detect_segments) {
+    line_flow_.add_detections(f.detected_segments, &f.result.line_tracking);
     f.result.line_tracking.detected = true;
   }
-  f.result.stages.lines_ms = ms_since(lines_start);
+  f.features.lines.segments = line_flow_.segments();
+  f.line_ids = line_flow_.ids();
+  f.result.stages.lines_ms = f.detection_ms + ms_since(start);
 }
 
 void VisualOdometry::track_points(Frame& f) {
@@ -92,7 +106,7 @@ void VisualOdometry::track_points(Frame& f) {
       if (all_finite(external.points[i])) f.points[external.point_ids[i]] = external.points[i];
   } else if (f.tracking) {
     // The searches on both threads, the second once it has detected the segments.
-    klt_.track_pyramid(f.pyramid, nullptr, f.input.stamp, worker_->parallel());
+    f.point_motion = klt_.track_pyramid(f.pyramid, nullptr, f.input.stamp, worker_->parallel());
     f.points = klt_points();
     if (f.klt_pyramid) f.pair.left = klt_.pyramid();
   } else {

@@ -29,6 +29,7 @@
 #include "hybrid_vo/evaluation/trajectory.h"
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/geometry/epipolar_error.h"
 #include "hybrid_vo/geometry/pose_error.h"
 
 namespace hybrid_vo {
@@ -50,7 +51,10 @@ void usage(const char* program) {
                " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
                " [--independent-translation-points N]\n"
                "       [--stereo-translation-margin M] [--line-flow | --no-line-flow]\n"
-               "       [--line-redetect-below F] [--line-detect-every N] [--verbose]\n"
+               "       [--line-redetect-below F] [--line-detect-every N] [--line-reach PX]\n"
+               "       [--line-young-reach PX] [--line-end-search PX] [--line-spacing PX]\n"
+               "       [--line-inset PX] [--line-min-residual PX] [--line-min-share F]\n"
+               "       [--line-min-correlation C] [--line-rival-ratio R] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --stereo: with the right images (metric scale, as kitti.launch stereo:=true).\n"
                "  --sequential: no worker thread; --lbd: full LBD matching instead of line\n"
@@ -101,7 +105,15 @@ void usage(const char* program) {
                "  --line-flow / --no-line-flow: segments followed by their flow and detected only\n"
                "  where their tracks thin out (line_flow), or detected and described every frame;\n"
                "  --line-redetect-below F, --line-detect-every N: when the flow's tracks are\n"
-               "  detected again (below F of the last detection's tracks, or N frames after it).\n";
+               "  detected again (below F of the last detection's tracks, or N frames after it);\n"
+               "  --line-reach, --line-young-reach: how far off its prediction a track is looked for\n"
+               "  (px; line_flow_tracking's min_reach_px and young_reach_px); --line-end-search,\n"
+               "  --line-spacing, --line-inset, --line-min-residual, --line-min-share,\n"
+               "  --line-min-correlation, --line-rival-ratio: SegmentFlowOptions' end_search_px,\n"
+               "  sample_spacing_px, end_inset_px, min_residual_px, min_inlier_share,\n"
+               "  min_correlation and rival_ratio.\n"
+               "  With ground truth it prints the matches' Sampson error under the true epipolar\n"
+               "  geometry: the points', and the junctions' that the pairs' segments make.\n";
 }
 
 // The median of each coordinate.
@@ -203,6 +215,24 @@ int run(int argc, char** argv) {
       o.line_flow_tracking.redetect_below = std::atof(argv[++i]);
     else if (a == "--line-detect-every" && i + 1 < argc)
       o.line_flow_tracking.max_frames_between_detections = std::atoi(argv[++i]);
+    else if (a == "--line-reach" && i + 1 < argc)
+      o.line_flow_tracking.min_reach_px = std::atof(argv[++i]);
+    else if (a == "--line-young-reach" && i + 1 < argc)
+      o.line_flow_tracking.young_reach_px = std::atof(argv[++i]);
+    else if (a == "--line-min-correlation" && i + 1 < argc)
+      o.line_flow_tracking.flow.min_correlation = std::atof(argv[++i]);
+    else if (a == "--line-rival-ratio" && i + 1 < argc)
+      o.line_flow_tracking.flow.rival_ratio = std::atof(argv[++i]);
+    else if (a == "--line-inset" && i + 1 < argc)
+      o.line_flow_tracking.flow.end_inset_px = std::atof(argv[++i]);
+    else if (a == "--line-min-residual" && i + 1 < argc)
+      o.line_flow_tracking.flow.min_residual_px = std::atof(argv[++i]);
+    else if (a == "--line-min-share" && i + 1 < argc)
+      o.line_flow_tracking.flow.min_inlier_share = std::atof(argv[++i]);
+    else if (a == "--line-end-search" && i + 1 < argc)
+      o.line_flow_tracking.flow.end_search_px = std::atof(argv[++i]);
+    else if (a == "--line-spacing" && i + 1 < argc)
+      o.line_flow_tracking.flow.sample_spacing_px = std::atof(argv[++i]);
     else if (a == "--min-corner-gradient" && i + 1 < argc)
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--min-corner-isotropy" && i + 1 < argc)
@@ -369,6 +399,8 @@ int run(int argc, char** argv) {
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
   int segment_detections = 0;  // frames whose segments were detected
+  // Every estimated pair's point matches and junctions: their Sampson error under the truth.
+  std::vector<double> point_truth_px, junction_truth_px;
   // Keyframes, and the answered frames a second after the first and those of them with a baseline.
   int keyframes = 1, late_answers = 0, late_baselines = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
@@ -419,6 +451,17 @@ int run(int argc, char** argv) {
           const RelativePose truth_pose{b.R_wc.transpose() * a.R_wc,
                                         b.R_wc.transpose() * (a.c_w - b.c_w)};
           pair_rot_deg.push_back(rotation_error(r.motion.R, truth_pose.R) * 180.0 / M_PI);
+          // The matches' quality: their distance to the true epipolar geometry (Sampson, px).
+          for (const PointMatch& m : r.matches.points) {
+            const double e = sampson_error_px(input.camera.pinhole, input.camera.pinhole,
+                                              truth_pose, m.x1, m.x2);
+            if (std::isfinite(e)) point_truth_px.push_back(e);
+          }
+          for (const DerivedPoint& j : r.estimate.estimate.junctions) {
+            const double e = sampson_error_px(input.camera.pinhole, input.camera.pinhole,
+                                              truth_pose, j.match.x1, j.match.x2);
+            if (std::isfinite(e)) junction_truth_px.push_back(e);
+          }
           // The motion and covariance the node publishes on ~relative_pose.
           const Eigen::Matrix<double, 6, 6>& C = r.motion_covariance;
           const bool valid = r.motion_covariance_valid;
@@ -694,6 +737,24 @@ int run(int argc, char** argv) {
               median(line_matches), median(line_inliers), median(tracked), median(started),
               lines_sum > 0.0 ? inliers_sum / lines_sum : 0.0, lines_sum);
   std::printf("segments detected in %d of %d frames\n", segment_detections, frames);
+  if (!point_truth_px.empty())
+    std::printf("matches under the true epipolar geometry (Sampson px, median / p90 / share "
+                "beyond 2 px): points %.3f / %.3f / %.1f %% of %zu, junctions %.3f / %.3f / "
+                "%.1f %% of %zu\n",
+                median(point_truth_px), percentile(point_truth_px, 0.9),
+                100.0 * std::count_if(point_truth_px.begin(), point_truth_px.end(),
+                                      [](double e) { return e > 2.0; }) /
+                    point_truth_px.size(),
+                point_truth_px.size(),
+                junction_truth_px.empty() ? NAN : median(junction_truth_px),
+                junction_truth_px.empty() ? NAN : percentile(junction_truth_px, 0.9),
+                junction_truth_px.empty()
+                    ? NAN
+                    : 100.0 *
+                          std::count_if(junction_truth_px.begin(), junction_truth_px.end(),
+                                        [](double e) { return e > 2.0; }) /
+                          junction_truth_px.size(),
+                junction_truth_px.size());
   std::printf("median per estimated frame: junctions %.0f (%.0f inliers), VPs %.0f (%.0f "
               "inliers)\n",
               median(junctions), median(junction_inliers), median(vp_matches),

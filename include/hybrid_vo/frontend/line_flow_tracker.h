@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "hybrid_vo/frontend/line_tracker.h"
+#include "hybrid_vo/frontend/point_flow_field.h"
 #include "hybrid_vo/frontend/segment_flow.h"
 #include "hybrid_vo/frontend/segment_motion.h"
 
@@ -21,9 +22,16 @@ namespace hybrid_vo {
 // 11-13 ms of a 640x480 frame (doc/performance.md).
 struct LineFlowTrackerOptions {
   SegmentFlowOptions flow;
-  // How far across itself a track is looked for around its prediction: min_reach_px plus
-  // motion_fraction of the motion its own velocity predicts (constant velocity is a guess), and
-  // young_reach_px for a track seen once, which has no velocity yet (LineTracker's tolerances).
+  // A track is predicted by the tracked points within point_radius_px of it (at least
+  // min_points; point_flow_field.h) and looked for up to min_reach_px plus spread_factor times
+  // their motions' spread across it around that. Without such points, by the camera's rotation
+  // and its own velocity: up to min_reach_px plus motion_fraction of the motion its velocity
+  // predicts (constant velocity is a guess), and young_reach_px for a track seen once, which has
+  // no velocity yet (LineTracker's tolerances); never farther than that. A wider search than
+  // the prediction needs meets parallel edges of the same contrast (a panel's seams).
+  double point_radius_px = 40.0;
+  int min_points = 4;
+  double spread_factor = 2.0;
   double min_reach_px = 4.0;
   double motion_fraction = 0.5;
   double young_reach_px = 12.0;
@@ -45,7 +53,8 @@ template <typename Visit>
 void visit_fields(LineFlowTrackerOptions& o, Visit&& visit) {
   visit_fields(o.flow, prefixed("flow_", visit));
   HYBRID_VO_FIELDS(fraction(), o.redetect_below, o.associate_overlap);
-  HYBRID_VO_FIELDS(non_negative(), o.min_reach_px, o.motion_fraction, o.young_reach_px);
+  HYBRID_VO_FIELDS(non_negative(), o.min_reach_px, o.motion_fraction, o.young_reach_px,
+                  o.point_radius_px, o.min_points, o.spread_factor);
   HYBRID_VO_FIELDS(positive(), o.max_frames_between_detections, o.associate_angle_deg,
                   o.associate_offset_px);
 }
@@ -57,11 +66,15 @@ class LineFlowTracker {
 
   // Moves the tracks from the last frame's image into this one's (pyramid_images of the
   // frame's pyramid); tracks the flow loses end. `stamp` and `image_motion` as LineTracker::track
-  // takes them. An image of another size starts afresh.
+  // takes them; `points`, optional, the motion of the tracked points into this frame. The tracks
+  // are independent: `parallel` may spread them over threads, with the same result. An image of
+  // another size starts afresh.
   void track(const std::vector<cv::Mat>& pyramid, double stamp,
              const Eigen::Matrix3d& image_motion = Eigen::Matrix3d::Identity(),
+             const PointFlowField* points = nullptr, const ParallelFor& parallel = {},
              LineTrackingStats* stats = nullptr);
-  // Whether this frame's segments should be detected (after track): see redetect_below.
+  // Whether the next frame's segments should be detected (before its track, so that the
+  // detector may run beside the points' tracking): see redetect_below.
   bool wants_detection() const;
   // This frame's detected segments (oriented by the gradient, as describe_line_segments gives
   // them): each refreshes the track it continues or starts one; a track that several continue

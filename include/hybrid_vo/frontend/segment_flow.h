@@ -18,11 +18,13 @@ namespace hybrid_vo {
 // where the edge stops.
 struct SegmentFlowOptions {
   // Samples about sample_spacing_px apart, at least min_samples and at most max_samples, the
-  // outer ones end_inset_px inside the ends (an edge's end is where its profile changes).
+  // outer ones end_inset_px inside the ends: near a corner the other edge bends a sample's
+  // profile, and a few tenths of a pixel at one end tilt a short segment by tenths of a degree
+  // (TartanAir's pairs 0.068 -> 0.061 degrees at 6 px instead of 3).
   double sample_spacing_px = 8.0;
   int min_samples = 6;
   int max_samples = 24;
-  double end_inset_px = 3.0;
+  double end_inset_px = 6.0;
   // The profile: 2 * profile_half_px + 1 values a pixel apart across the edge (2 to 30).
   int profile_half_px = 4;
   // The search: at most +- search_px pixels (at most 40) of the level it starts at, the finest
@@ -30,11 +32,14 @@ struct SegmentFlowOptions {
   // finer one; at full resolution to a fraction of a pixel.
   int search_px = 6;
   int levels = 2;
-  // A sample is found where the profiles' normalised correlation reaches min_correlation, and
-  // no other peak of the coarse search 2 px or more away is nearly as good (a parallel edge of
-  // the same contrast): its decorrelation (1 - correlation) at most rival_ratio times the
-  // best's plus rival_margin. A shifted step still correlates 0.9 with itself, so the
-  // correlations alone cannot be compared by a ratio.
+  // The coarse search is the segment's: the offset (and its change along the segment, up to
+  // coarse_turn_deg) on which the samples' profile correlations agree best; it fails where
+  // another peak 2 px or more away is nearly as good (a parallel edge of the same contrast): its
+  // decorrelation (1 - mean correlation) at most rival_ratio times the best's plus
+  // rival_margin. A shifted step still correlates 0.9 with itself, so the correlations alone
+  // cannot be compared by a ratio. Each sample is then found from there where its correlation
+  // reaches min_correlation.
+  double coarse_turn_deg = 3.0;
   double min_correlation = 0.8;
   double rival_ratio = 3.0;
   double rival_margin = 0.02;
@@ -50,11 +55,12 @@ struct SegmentFlowOptions {
   int min_inliers = 4;
   double min_inlier_share = 0.6;
   double max_turn_deg = 10.0;
-  // The ends are looked for up to this far beyond the predicted ones (a segment coming closer
-  // grows).
-  double end_search_px = 8.0;
+  // The ends are looked for up to this far beyond the predicted ones (0: within them; a segment
+  // grows when the detector sees more of it). Longer segments met more others in junctions that
+  // did not serve: KITTI 06's 1 s windows 0.067 -> 0.082 degrees at 8 px, 0.071 at 0.
+  double end_search_px = 0.0;
   // Shorter segments are lost (they carry little direction).
-  double min_length_px = 20.0;
+  double min_length_px = 30.0;
 };
 
 template <typename Visit>
@@ -66,7 +72,7 @@ void visit_fields(SegmentFlowOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(non_negative(), o.end_inset_px, o.levels, o.min_length_px, o.min_residual_px,
                   o.end_search_px);
   HYBRID_VO_FIELDS(fraction(), o.min_correlation, o.rival_margin, o.min_inlier_share);
-  HYBRID_VO_FIELDS(non_negative(), o.rival_ratio);
+  HYBRID_VO_FIELDS(non_negative(), o.rival_ratio, o.coarse_turn_deg);
 }
 
 // Where one segment went.

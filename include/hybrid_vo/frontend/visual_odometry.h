@@ -347,6 +347,11 @@ class VisualOdometry {
   // matching share (built when one of them needs it).
   void build_pyramid(Frame& f) const;
   void track_segments(Frame& f);      // detected, described and tracked (the second thread)
+  // line_flow: the frame's segments detected on the second thread where the tracks want them,
+  // beside the points; then, once the points are tracked, the tracks followed by the flow (on
+  // both threads) and the detections taken on.
+  void start_segment_detection(Frame& f);
+  void follow_segments(Frame& f);
   void track_points(Frame& f);        // KLT (searches on both threads), external or descriptors
   void match_points(Frame& f) const;  // with the keyframe's, and the parallax
   void start_redetection(Frame& f);   // its cells shared by both threads
