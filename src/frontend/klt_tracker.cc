@@ -91,6 +91,7 @@ void KltTracker::reset() {
   stamp_ = motion_dt_ = kNoStamp;
   detections_ = 0;
   refilled_to_ = 0;
+  cell_tracks_.clear();
 }
 
 int KltTracker::num_tracks() const { return static_cast<int>(points_.size()); }
@@ -336,8 +337,11 @@ KltDetection KltTracker::plan_detection() const {
   const bool enough = !points_.empty() && refill < 1.0 &&
                       (points_.size() >= refill * max_features ||
                        static_cast<double>(points_.size()) >= refill * refilled_to_);
+  const bool lost_only = options_.redetect_lost_cells &&
+                         static_cast<int>(cell_tracks_.size()) == d.cells();
   for (int c = 0; c < d.cells(); ++c) {
     d.wanted[c] = enough ? 0 : quota - count[c];
+    if (lost_only && count[c] >= cell_tracks_[c] && cell_tracks_[c] > 0) d.wanted[c] = 0;
     if (d.wanted[c] < min_missing) d.wanted[c] = 0;
     const int cx = c % cols, cy = c / cols;
     if (alternate && (cx + cy + detections_) % 2 != 0) d.wanted[c] = 0;
@@ -457,6 +461,13 @@ void KltTracker::add_detections(const KltDetection& d) {
       refilled_to_ = static_cast<int>(points_.size());
       break;
     }
+  cell_tracks_.assign(d.cells(), 0);
+  if (d.cells() <= 0) return;
+  for (const cv::Point2f& p : points_) {
+    const int cx = std::clamp(static_cast<int>(p.x) / std::max(1, d.cell_w), 0, d.cols - 1);
+    const int cy = std::clamp(static_cast<int>(p.y) / std::max(1, d.cell_h), 0, d.rows - 1);
+    ++cell_tracks_[cy * d.cols + cx];
+  }
 }
 
 }  // namespace hybrid_vo

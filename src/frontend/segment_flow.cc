@@ -164,21 +164,23 @@ bool coarse_fit(const std::vector<std::vector<float>>& scores, const std::vector
   // samples that disagree).
   std::vector<float> total(offsets, -2.0f);
   std::vector<double> turn_of(offsets, 0.0);
-  for (int d = 0; d < offsets; ++d)
-    for (int half_steps = -2 * max_turn; half_steps <= 2 * max_turn; ++half_steps) {
-      CoarseFit candidate;
-      candidate.offset = d;
-      candidate.turn = 0.5 * half_steps;
+  std::vector<int> shift(usable);
+  for (int half_steps = -2 * max_turn; half_steps <= 2 * max_turn; ++half_steps) {
+    CoarseFit turned;
+    turned.turn = 0.5 * half_steps;
+    for (int i = 0; i < usable; ++i) shift[i] = turned.at(where[i]);
+    for (int d = 0; d < offsets; ++d) {
       float sum = 0.0f;
       for (int i = 0; i < usable; ++i) {
-        const int k = candidate.at(where[i]);
+        const int k = d + shift[i];
         if (k >= 0 && k < offsets) sum += scores[i][k];
       }
       if (sum / usable > total[d]) {
         total[d] = sum / usable;
-        turn_of[d] = candidate.turn;
+        turn_of[d] = turned.turn;
       }
     }
+  }
   const int best = static_cast<int>(std::max_element(total.begin(), total.end()) - total.begin());
   // Another peak nearly as good (inside the search: one at its end may be the best's slope).
   const float rival = static_cast<float>(o.rival_ratio * (1.0 - total[best]) + o.rival_margin);

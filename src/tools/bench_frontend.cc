@@ -93,7 +93,8 @@ void usage(const char* program) {
                "  --work-level L: its min_work_level, a fixed level 0-4 (cpu_budget.h);\n"
                "  --max-features N: the point budget (default 1500, as config/kitti.yaml);\n"
                "  --redetect-alternate: KLT re-detection in half the cells per frame, taking\n"
-               "  turns (klt_redetect_alternate: true).\n"
+               "  turns (klt_redetect_alternate: true); --redetect-lost-cells: only in the cells\n"
+               "  that lost tracks since the last frame (klt_redetect_lost_cells).\n"
                "  --rotation-calibration-sigma S: the node's rotation_calibration_sigma (how far\n"
                "  every rotation may be off as a share of its angle; config/kitti.yaml: 0).\n"
                "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
@@ -240,6 +241,7 @@ int run(int argc, char** argv) {
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--drop-leaving") o.klt.drop_leaving = true;
     else if (a == "--redetect-alternate") o.klt.redetect_alternate = true;
+    else if (a == "--redetect-lost-cells") o.klt.redetect_lost_cells = true;
     else if (a == "--strongest-first") o.klt.strongest_first = true;
     else if (a == "--no-strongest-first") o.klt.strongest_first = false;
     else if (a == "--weak-corner-gradient" && i + 1 < argc)
