@@ -203,6 +203,7 @@ TEST(LineFlowTracker, KeepsIdsAlongTheFlowAndAsksForTheDetectorWhenTracksThinOut
   const Scene scene = quadrilaterals();
   LineFlowTrackerOptions options;
   options.max_frames_between_detections = 100;
+  options.max_seconds_between_detections = 100.0;
   LineFlowTracker tracker(options);
   tracker.track(levels(render(scene, Eigen::Matrix3d::Identity())), 1.0);
   EXPECT_TRUE(tracker.wants_detection());  // nothing to follow yet
@@ -256,6 +257,27 @@ TEST(LineFlowTracker, KeepsIdsAlongTheFlowAndAsksForTheDetectorWhenTracksThinOut
   tracker.track(levels(next), 1.5, Eigen::Matrix3d::Identity(), nullptr, {}, &stats);
   EXPECT_GE(stats.dropped, 8);
   EXPECT_TRUE(tracker.wants_detection());
+}
+
+TEST(LineFlowTracker, TheDetectorRunsAgainAfterAFewFramesOrAShortWhile) {
+  const Scene scene = quadrilaterals();
+  const std::vector<cv::Mat> image = levels(render(scene, Eigen::Matrix3d::Identity()));
+  for (const double seconds : {0.25, 100.0}) {
+    LineFlowTrackerOptions options;
+    options.max_frames_between_detections = 4;
+    options.max_seconds_between_detections = seconds;
+    LineFlowTracker tracker(options);
+    tracker.track(image, 1.0);
+    tracker.add_detections(scene.segments);
+    int frames = 1;
+    while (frames < 10) {
+      tracker.track(image, 1.0 + 0.1 * frames);
+      if (tracker.wants_detection()) break;
+      ++frames;
+    }
+    // 0.25 s: the frame at 1.3 s would come too late; else the fourth frame after it.
+    EXPECT_EQ(frames, seconds < 1.0 ? 2 : 3) << seconds;
+  }
 }
 
 TEST(LineFlowTracker, OneDetectionContinuingTwoTracksMergesThemIntoTheOldest) {

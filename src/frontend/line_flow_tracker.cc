@@ -46,6 +46,7 @@ void LineFlowTracker::reset() {
   started_ = false;
   now_ = 0.0;
   frames_since_detection_ = 0;
+  detected_at_ = last_step_ = 0.0;
   tracks_after_detection_ = 0;
 }
 
@@ -67,6 +68,7 @@ void LineFlowTracker::track(const std::vector<cv::Mat>& pyramid, double stamp,
   if ((started_ && now < now_) || pyramid.empty() ||
       (!previous_.empty() && previous_[0].size() != pyramid[0].size()))
     reset();
+  last_step_ = started_ && std::isfinite(stamp) ? now - now_ : 0.0;
   started_ = true;
   now_ = now;
   ++frames_since_detection_;
@@ -123,6 +125,8 @@ void LineFlowTracker::track(const std::vector<cv::Mat>& pyramid, double stamp,
 bool LineFlowTracker::wants_detection() const {
   return tracks_.empty() ||
          frames_since_detection_ + 1 >= options_.max_frames_between_detections ||
+         (last_step_ > 0.0 &&
+          now_ + last_step_ - detected_at_ > options_.max_seconds_between_detections + 1e-9) ||
          static_cast<double>(tracks_.size()) <
              options_.redetect_below * static_cast<double>(tracks_after_detection_);
 }
@@ -186,6 +190,7 @@ void LineFlowTracker::add_detections(const std::vector<LineSegment>& detected,
   }
   tracks_ = std::move(kept);
   frames_since_detection_ = 0;
+  detected_at_ = now_;
   tracks_after_detection_ = static_cast<int>(tracks_.size());
 }
 

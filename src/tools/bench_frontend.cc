@@ -107,6 +107,7 @@ void usage(const char* program) {
                "  where their tracks thin out (line_flow), or detected and described every frame;\n"
                "  --line-redetect-below F, --line-detect-every N: when the flow's tracks are\n"
                "  detected again (below F of the last detection's tracks, or N frames after it);\n"
+               "  --line-detect-seconds S: ... or S seconds after it.\n"
                "  --line-reach, --line-young-reach: how far off its prediction a track is looked for\n"
                "  (px; line_flow_tracking's min_reach_px and young_reach_px); --line-end-search,\n"
                "  --line-spacing, --line-inset, --line-min-residual, --line-min-share,\n"
@@ -216,6 +217,8 @@ int run(int argc, char** argv) {
       o.line_flow_tracking.redetect_below = std::atof(argv[++i]);
     else if (a == "--line-detect-every" && i + 1 < argc)
       o.line_flow_tracking.max_frames_between_detections = std::atoi(argv[++i]);
+    else if (a == "--line-detect-seconds" && i + 1 < argc)
+      o.line_flow_tracking.max_seconds_between_detections = std::atof(argv[++i]);
     else if (a == "--line-reach" && i + 1 < argc)
       o.line_flow_tracking.min_reach_px = std::atof(argv[++i]);
     else if (a == "--line-young-reach" && i + 1 < argc)

@@ -39,7 +39,7 @@ struct SegmentFlowOptions {
   // rival_margin. A shifted step still correlates 0.9 with itself, so the correlations alone
   // cannot be compared by a ratio. Each sample is then found from there where its correlation
   // reaches min_correlation.
-  double coarse_turn_deg = 2.0;
+  double coarse_turn_deg = 3.0;
   double min_correlation = 0.8;
   double rival_ratio = 3.0;
   double rival_margin = 0.02;
@@ -55,10 +55,11 @@ struct SegmentFlowOptions {
   int min_inliers = 4;
   double min_inlier_share = 0.6;
   double max_turn_deg = 10.0;
-  // The ends are looked for up to this far beyond the predicted ones (a segment coming closer
-  // grows; else when the detector sees more of it). Far beyond, segments met others in junctions
-  // that did not serve: KITTI 06's 1 s windows 0.067 -> 0.082 degrees at 8 px, 0.071 at 0.
-  double end_search_px = 4.0;
+  // The ends are looked for up to this far beyond the predicted ones (0: within them; a segment
+  // grows when the detector sees more of it). Beyond, segments met others in junctions that did
+  // not serve: KITTI 06's 1 s windows 0.067 -> 0.082 degrees at 8 px, 0.071 at 0 (seeds 0-4),
+  // TartanAir's 0.105 -> 0.147 at 4 px, 0.114 at 0.
+  double end_search_px = 0.0;
   // Shorter segments are lost (they carry little direction).
   double min_length_px = 30.0;
 };
