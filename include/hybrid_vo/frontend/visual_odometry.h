@@ -143,7 +143,7 @@ struct VisualOdometryOptions {
 // the node sets.
 template <typename Visit>
 void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
-  HYBRID_VO_FIELDS(any_value(), o.use_lines, o.track_lines, o.concurrent,
+  HYBRID_VO_FIELDS(any_value(), o.use_lines, o.track_lines, o.line_flow, o.concurrent,
                   o.stereo_current_disparity, o.stereo_refine_tracks, o.use_direction_map,
                   o.anchor_orientation);
   visit("max_features", o.features.points.max_features, positive());
