@@ -594,6 +594,40 @@ TEST(KltTracker, RefillWaitsUntilAShareOfTheLastRefillIsLost) {
   EXPECT_GT(cells, 0);
 }
 
+TEST(KltTracker, OnlyTheCellsThatLostTracksLookAgain) {
+  // A still textured image: after the first frame's detection every cell keeps its tracks, and
+  // none looks again; a patch painted flat takes a cell's tracks, and that cell alone looks.
+  const cv::Mat texture = hybrid_vo::testing::blurred_noise(480, 640, 2.5);
+  KltTrackerOptions options;
+  options.redetect_lost_cells = true;
+  KltTracker tracker(options, 3000);  // more than the texture's corners: no cell reaches its quota
+  tracker.track(texture, nullptr, 0.0);
+  ASSERT_GT(tracker.num_tracks(), 200);
+  auto wanting = [&] {
+    const KltDetection d = tracker.plan_detection();
+    std::vector<int> cells;
+    for (int c = 0; c < d.cells(); ++c)
+      if (d.wanted[c] > 0) cells.push_back(c);
+    return cells;
+  };
+  tracker.track_existing(texture, nullptr, 0.1);
+  EXPECT_TRUE(wanting().empty());
+  tracker.detect_new();
+  cv::Mat painted = texture.clone();
+  // Cell (2, 1) of the 8 x 6 grid spans x 160-240, y 80-160.
+  cv::rectangle(painted, cv::Rect(170, 90, 60, 60), cv::Scalar(128), cv::FILLED);
+  tracker.track_existing(painted, nullptr, 0.2);
+  EXPECT_EQ(wanting(), std::vector<int>{1 * 8 + 2});
+  // Without the option every cell short of its quota looks, every frame.
+  KltTracker always(KltTrackerOptions(), 3000);
+  always.track(texture, nullptr, 0.0);
+  always.track_existing(texture, nullptr, 0.1);
+  const KltDetection d = always.plan_detection();
+  int cells = 0;
+  for (int c = 0; c < d.cells(); ++c) cells += d.wanted[c] > 0;
+  EXPECT_GT(cells, 40);
+}
+
 TEST(KltTracker, AlternateRedetectionFillsHalfTheCellsByTurns) {
   const cv::Mat texture = hybrid_vo::testing::blurred_noise(700, 1000, 2.5);
   auto frame = [&](int k) {  // a pan: features leave on one side, cells empty on the other

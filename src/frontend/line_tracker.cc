@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "hybrid_vo/frontend/segment_motion.h"
+
 namespace hybrid_vo {
 namespace {
 
@@ -77,28 +79,6 @@ bool same_line(const LineSegment& s, const LineSegment& t, double tolerance) {
          std::abs(lt.dot(homogeneous(s.p2))) <= tolerance;
 }
 
-double direction_angle(const LineSegment& s) {
-  return std::atan2(s.p2.y() - s.p1.y(), s.p2.x() - s.p1.x());
-}
-
-double wrap_angle(double a) { return std::remainder(a, 2.0 * M_PI); }
-
-// A segment's endpoints carried by a homography; false when one lands at infinity.
-bool transfer(const Eigen::Matrix3d& H, const LineSegment& s, LineSegment* out) {
-  const Eigen::Vector3d a = H * homogeneous(s.p1), b = H * homogeneous(s.p2);
-  if (!(std::abs(a.z()) > 1e-12) || !(std::abs(b.z()) > 1e-12)) return false;
-  *out = LineSegment(a.head<2>() / a.z(), b.head<2>() / b.z());
-  return all_finite(out->p1) && all_finite(out->p2);
-}
-
-// Both segments' line motion: the foot of a's midpoint on b's line minus the midpoint, and the
-// turn from a's direction to b's.
-void line_motion(const LineSegment& a, const LineSegment& b, Eigen::Vector2d* shift, double* turn) {
-  const Eigen::Vector3d l = line_through(b.p1, b.p2);
-  *shift = -l.dot(homogeneous(a.midpoint())) * l.head<2>();
-  *turn = wrap_angle(direction_angle(b) - direction_angle(a));
-}
-
 }  // namespace
 
 LineTracker::LineTracker(const LineTrackerOptions& options, const LineMatchingOptions& matching)
@@ -108,17 +88,6 @@ void LineTracker::reset() {
   tracks_.clear();
   started_ = false;
   now_ = 0.0;
-}
-
-LineSegment LineTracker::predict(const Track& t, double now, const Eigen::Matrix3d& image_motion) {
-  LineSegment carried;
-  if (!transfer(image_motion, t.segment, &carried)) carried = t.segment;
-  if (!t.has_motion) return carried;
-  const double dt = now - t.seen_at;
-  const Eigen::Vector2d mid = carried.midpoint();
-  const Eigen::Vector2d moved = mid + dt * t.shift;
-  const Eigen::Rotation2Dd turn(dt * t.turn);
-  return LineSegment(moved + turn * (carried.p1 - mid), moved + turn * (carried.p2 - mid));
 }
 
 std::vector<int64_t> LineTracker::track(const LineFeatures& current, double stamp,
@@ -155,16 +124,17 @@ LineTracker::Search LineTracker::search(const LineFeatures& current, double now,
   s.carried.resize(m);
   for (int k = 0; k < m; ++k) {
     const Track& t = tracks_[k];
-    if (!transfer(H, t.segment, &s.carried[k])) s.carried[k] = t.segment;
-    const LineSegment& predicted = s.predictions[k] = predict(t, now, H);
+    if (!transfer_segment(H, t.segment, &s.carried[k])) s.carried[k] = t.segment;
+    const LineSegment& predicted = s.predictions[k] =
+        predict_segment(t.segment, t.motion, now - t.seen_at, H);
     // The own motion's guess is uncertain by a fraction of it; the rotation's is not.
     const double motion = std::max((predicted.p1 - s.carried[k].p1).norm(),
                                    (predicted.p2 - s.carried[k].p2).norm());
-    const double tolerance = t.has_motion
+    const double tolerance = t.motion.known
                                  ? options_.max_offset_px + options_.motion_fraction * motion
                                  : options_.max_offset_young_px;
     const double cos_angle = std::cos(
-        (t.has_motion ? options_.max_angle_deg : options_.young_angle_deg) * M_PI / 180.0);
+        (t.motion.known ? options_.max_angle_deg : options_.young_angle_deg) * M_PI / 180.0);
     find_candidates(predicted, current.segments, tolerance, cos_angle, options_.min_overlap,
                     &candidates);
     if (candidates.empty()) continue;
@@ -257,15 +227,8 @@ std::vector<int64_t> LineTracker::update_tracks(const LineFeatures& current, dou
     }
     const LineSegment& seen = current.segments[j];
     const double dt = now - t.seen_at;
-    if (dt > 0.0) {
-      // The motion beyond the rotation's: from the carried segment to the one seen.
-      Eigen::Vector2d shift;
-      double turn;
-      line_motion(s.carried[k], seen, &shift, &turn);
-      t.shift = shift / dt;
-      t.turn = turn / dt;
-      t.has_motion = true;
-    }
+    // The motion beyond the rotation's: from the carried segment to the one seen.
+    if (dt > 0.0) t.motion = segment_motion_between(s.carried[k], seen, dt);
     t.segment = seen;
     t.seen_at = now;
     t.missed = 0;

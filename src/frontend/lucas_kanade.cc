@@ -19,16 +19,16 @@ void lucas_kanade_search(const std::vector<cv::Mat>& from_pyramid,
     a.push_back(from[i]);
     b.push_back((*to)[i]);
   }
+  // No error output: OpenCV then skips the pass over each window that measures it.
   std::vector<uchar> status;
-  std::vector<float> error;
   const cv::TermCriteria criteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS,
                                   std::max(1, max_iterations), 0.01);
   if (levels < 0) {
-    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, error, window,
+    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, cv::noArray(), window,
                              pyramid_levels, criteria);
   } else {
-    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, error, window, levels,
-                             criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
+    cv::calcOpticalFlowPyrLK(from_pyramid, to_pyramid, a, b, status, cv::noArray(), window,
+                             levels, criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
   }
   for (size_t k = 0; k < which.size(); ++k) {
     (*to)[which[k]] = b[k];

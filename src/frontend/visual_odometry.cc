@@ -47,6 +47,7 @@ VisualOdometry::VisualOdometry(const VisualOdometryOptions& options)
       worker_(std::make_unique<WorkerThread>(options.concurrent)),
       klt_(options.klt, options.features.points.max_features),
       line_tracker_(options.line_tracking, options.features.lines),
+      line_flow_(options.line_flow_tracking),
       orientation_(options),
       offset_filter_(options.stereo_offset),
       budget_(options.budget) {
@@ -67,6 +68,7 @@ void VisualOdometry::restart() {
   orientation_.restart();
   klt_.reset();
   line_tracker_.reset();
+  line_flow_.reset();
   keyframe_ = Keyframe();
   last_answer_stamp_ = -1e300;
   mono_speed_ = -1.0;
@@ -94,9 +96,13 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   // refinement. This thread tracks the points meanwhile, then estimates while the second one
   // matches the stereo points, and takes what is left of a shared stage when it needs its results.
   if (f.stereo) f.pyramids_job = worker_->submit([this, &f] { build_stereo_pyramids(f); });
-  if (options_.use_lines && !input.external.has_lines)
-    f.segments_job = worker_->submit([this, &f] { track_segments(f); });
+  build_pyramid(f);                        // before the segments, which may follow its flow
+  const bool lines = options_.use_lines && !input.external.has_lines;
+  const bool flow = lines && options_.track_lines && options_.line_flow;
+  if (flow) start_segment_detection(f);
+  else if (lines) f.segments_job = worker_->submit([this, &f] { track_segments(f); });
   track_points(f);                         // both threads (the KLT searches)
+  if (flow) follow_segments(f);            // both threads
   match_points(f);                         // this thread, as everything not marked
   // Both threads; a skipped frame needs none, a rotation-only one its translation in stereo.
   if (!low_parallax(f) || options_.rotation_only_pairs) start_stereo(f);

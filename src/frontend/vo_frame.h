@@ -43,6 +43,7 @@ struct VisualOdometry::Frame {
   bool tracking = false;     // points are KLT tracks (not external, not descriptors)
   bool stereo = false;       // a right image with a baseline: metric scale
   bool klt_pyramid = false;  // the KLT tracker's pyramid of the image serves the stereo matching
+  std::vector<cv::Mat> pyramid;  // the image's (build_pyramid), or empty
   // How the segments move from the last frame as the camera turns at its last rate.
   Eigen::Matrix3d segment_motion = Eigen::Matrix3d::Identity();
 
@@ -50,6 +51,12 @@ struct VisualOdometry::Frame {
   std::map<int64_t, Eigen::Vector2d> points;  // by id; the tracked ones until re-detection
   ImageFeatures features;                     // segments (and descriptor points)
   std::vector<int64_t> line_ids;              // with track_lines: the track of each segment
+  // With line_flow: the KLT tracks' motion into this frame, which predicts the segments'; and
+  // the frame's detected segments (oriented), when the tracks want them.
+  std::vector<PointMatch> point_motion;
+  bool detect_segments = false;
+  std::vector<LineSegment> detected_segments;
+  double detection_ms = 0.0;
   std::vector<int64_t> point_ids;             // per point match: its id
   // The median transfer error of the point matches under the rotation that best explains them
   // (the parallax after the rotation), or their median motion where no rotation was found;
@@ -99,7 +106,7 @@ struct VisualOdometry::Frame {
   WorkClock redetect_clock;
 
   // The second thread's work (see above).
-  WorkerJob pyramids_job, segments_job;
+  WorkerJob pyramids_job, segments_job, detection_job;
   SharedLoop stereo_loop, redetection;
 };
 

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include <opencv2/video/tracking.hpp>
+
 #include "vo_frame.h"
 
 namespace hybrid_vo {
@@ -40,24 +42,71 @@ void VisualOdometry::apply_work_level(int level) {
       (level < 3 || !options_.track_lines) && segment_options_.description.describe;
 }
 
+void VisualOdometry::build_pyramid(Frame& f) const {
+  const auto start = std::chrono::steady_clock::now();
+  const bool flow = options_.use_lines && options_.track_lines && options_.line_flow &&
+                    !f.input.external.has_lines;
+  if (f.tracking) {
+    f.pyramid = klt_.build_pyramid(f.gray);
+  } else if (flow) {
+    const int window = options_.klt.window_px;
+    cv::buildOpticalFlowPyramid(f.gray.mat(), f.pyramid, cv::Size(window, window),
+                                options_.line_flow_tracking.flow.levels, false);
+  }
+  f.result.stages.points_ms += ms_since(start);
+}
+
 void VisualOdometry::track_segments(Frame& f) {
   const auto lines_start = std::chrono::steady_clock::now();
   f.features.lines = detect_line_features(f.gray, segment_options_);
   if (options_.track_lines)
     f.line_ids = line_tracker_.track(f.features.lines, f.input.stamp, &f.result.line_tracking,
                                      f.segment_motion);
+  f.result.line_tracking.detected = true;
   f.result.stages.lines_ms = ms_since(lines_start);
+}
+
+void VisualOdometry::start_segment_detection(Frame& f) {
+  // Without descriptors: the flow's tracks match nothing by them.
+  f.detect_segments = line_flow_.wants_detection();
+  if (!f.detect_segments) return;
+  f.detection_job = worker_->submit([this, &f] {
+    const auto start = std::chrono::steady_clock::now();
+    LineDescriptionOptions oriented = segment_options_.description;
+    oriented.describe = false;
+    f.detected_segments =
+        describe_line_segments(f.gray, detect_line_segments(f.gray, segment_options_.detection),
+                               nullptr, oriented)
+            .segments;
+    f.detection_ms = ms_since(start);
+  });
+}
+
+void VisualOdometry::follow_segments(Frame& f) {
+  const auto start = std::chrono::steady_clock::now();
+  const PointFlowField points(f.point_motion);
+  line_flow_.track(pyramid_images(f.pyramid), f.input.stamp, f.segment_motion, &points,
+                   worker_->parallel(), &f.result.line_tracking);
+  f.detection_job.get();
+  if (f.detect_segments) {
+    line_flow_.add_detections(f.detected_segments, &f.result.line_tracking);
+    f.result.line_tracking.detected = true;
+  }
+  f.features.lines.segments = line_flow_.segments();
+  f.line_ids = line_flow_.ids();
+  f.result.stages.lines_ms = f.detection_ms + ms_since(start);
 }
 
 void VisualOdometry::track_points(Frame& f) {
   const ExternalFeatures& external = f.input.external;
   const auto points_start = std::chrono::steady_clock::now();
+  const double pyramid_ms = f.result.stages.points_ms;
   if (external.has_points) {
     for (size_t i = 0; i < external.points.size() && i < external.point_ids.size(); ++i)
       if (all_finite(external.points[i])) f.points[external.point_ids[i]] = external.points[i];
   } else if (f.tracking) {
     // The searches on both threads, the second once it has detected the segments.
-    klt_.track_existing(f.gray, nullptr, f.input.stamp, worker_->parallel());
+    f.point_motion = klt_.track_pyramid(f.pyramid, nullptr, f.input.stamp, worker_->parallel());
     f.points = klt_points();
     if (f.klt_pyramid) f.pair.left = klt_.pyramid();
   } else {
@@ -66,7 +115,7 @@ void VisualOdometry::track_points(Frame& f) {
     for (size_t i = 0; i < keypoints.size(); ++i)
       f.points[static_cast<int64_t>(i)] = Eigen::Vector2d(keypoints[i].pt.x, keypoints[i].pt.y);
   }
-  f.result.stages.points_ms = ms_since(points_start);
+  f.result.stages.points_ms = pyramid_ms + ms_since(points_start);
 }
 
 void VisualOdometry::match_points(Frame& f) const {

@@ -30,6 +30,7 @@
 #include "hybrid_vo/evaluation/trajectory.h"
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/geometry/epipolar_error.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/node/parameters_file.h"
 
@@ -53,7 +54,11 @@ void usage(const char* program) {
                " [--no-rotation-only] [--keyframe-overlap F] [--keyframe-parallax P] [--mono-window K]"
                " [--no-strongest-first] [--weak-corner-gradient G] [--weak-corner-share S]"
                " [--independent-translation-points N]\n"
-               "       [--stereo-translation-margin M] [--verbose]\n"
+               "       [--stereo-translation-margin M] [--line-flow | --no-line-flow]\n"
+               "       [--line-redetect-below F] [--line-detect-every N] [--line-reach PX]\n"
+               "       [--line-young-reach PX] [--line-end-search PX] [--line-spacing PX]\n"
+               "       [--line-inset PX] [--line-min-residual PX] [--line-min-share F]\n"
+               "       [--line-min-correlation C] [--line-rival-ratio R] [--verbose]\n"
                "  SEQUENCE_DIR: <root>/sequences/<name> (image_0, calib.txt; image_1 for --stereo).\n"
                "  --config FILE: the node's parameters from FILE (config/*.yaml), so that the run is\n"
                "  the node's with `config:=FILE` (without it: the KITTI settings below); --preset\n"
@@ -98,7 +103,8 @@ void usage(const char* program) {
                "  --work-level L: its min_work_level, a fixed level 0-4 (cpu_budget.h);\n"
                "  --max-features N: the point budget (default 1500, as config/kitti.yaml);\n"
                "  --redetect-alternate: KLT re-detection in half the cells per frame, taking\n"
-               "  turns (klt_redetect_alternate: true).\n"
+               "  turns (klt_redetect_alternate: true); --redetect-lost-cells: only in the cells\n"
+               "  that lost tracks since the last frame (klt_redetect_lost_cells).\n"
                "  --rotation-calibration-sigma S: the node's rotation_calibration_sigma (how far\n"
                "  every rotation may be off as a share of its angle; config/kitti.yaml: 0).\n"
                "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
@@ -108,7 +114,20 @@ void usage(const char* program) {
                "  keyframe link's length fitted with the last links over K keyframes; < 3: off).\n"
                "  --stereo-translation-margin M: a stereo pair takes\n"
                "  the stereo points' translation where its covariance is M times smaller (0:\n"
-               "  never; default 2).\n";
+               "  never; default 2).\n"
+               "  --line-flow / --no-line-flow: segments followed by their flow and detected only\n"
+               "  where their tracks thin out (line_flow), or detected and described every frame;\n"
+               "  --line-redetect-below F, --line-detect-every N: when the flow's tracks are\n"
+               "  detected again (below F of the last detection's tracks, or N frames after it);\n"
+               "  --line-detect-seconds S: ... or S seconds after it.\n"
+               "  --line-reach, --line-young-reach: how far off its prediction a track is looked for\n"
+               "  (px; line_flow_tracking's min_reach_px and young_reach_px); --line-end-search,\n"
+               "  --line-spacing, --line-inset, --line-min-residual, --line-min-share,\n"
+               "  --line-min-correlation, --line-rival-ratio: SegmentFlowOptions' end_search_px,\n"
+               "  sample_spacing_px, end_inset_px, min_residual_px, min_inlier_share,\n"
+               "  min_correlation and rival_ratio.\n"
+               "  With ground truth it prints the matches' Sampson error under the true epipolar\n"
+               "  geometry: the points', and the junctions' that the pairs' segments make.\n";
 }
 
 // The median of each coordinate.
@@ -243,6 +262,32 @@ int run(int argc, char** argv) {
     else if ((a == "--preset" || a == "--config" || a == "--param") && i + 1 < argc) ++i;
     else if (a == "--sequential") o.concurrent = false;
     else if (a == "--lbd") o.track_lines = false;
+    else if (a == "--line-flow") o.line_flow = true;
+    else if (a == "--no-line-flow") o.line_flow = false;
+    else if (a == "--line-redetect-below" && i + 1 < argc)
+      o.line_flow_tracking.redetect_below = std::atof(argv[++i]);
+    else if (a == "--line-detect-every" && i + 1 < argc)
+      o.line_flow_tracking.max_frames_between_detections = std::atoi(argv[++i]);
+    else if (a == "--line-detect-seconds" && i + 1 < argc)
+      o.line_flow_tracking.max_seconds_between_detections = std::atof(argv[++i]);
+    else if (a == "--line-reach" && i + 1 < argc)
+      o.line_flow_tracking.min_reach_px = std::atof(argv[++i]);
+    else if (a == "--line-young-reach" && i + 1 < argc)
+      o.line_flow_tracking.young_reach_px = std::atof(argv[++i]);
+    else if (a == "--line-min-correlation" && i + 1 < argc)
+      o.line_flow_tracking.flow.min_correlation = std::atof(argv[++i]);
+    else if (a == "--line-rival-ratio" && i + 1 < argc)
+      o.line_flow_tracking.flow.rival_ratio = std::atof(argv[++i]);
+    else if (a == "--line-inset" && i + 1 < argc)
+      o.line_flow_tracking.flow.end_inset_px = std::atof(argv[++i]);
+    else if (a == "--line-min-residual" && i + 1 < argc)
+      o.line_flow_tracking.flow.min_residual_px = std::atof(argv[++i]);
+    else if (a == "--line-min-share" && i + 1 < argc)
+      o.line_flow_tracking.flow.min_inlier_share = std::atof(argv[++i]);
+    else if (a == "--line-end-search" && i + 1 < argc)
+      o.line_flow_tracking.flow.end_search_px = std::atof(argv[++i]);
+    else if (a == "--line-spacing" && i + 1 < argc)
+      o.line_flow_tracking.flow.sample_spacing_px = std::atof(argv[++i]);
     else if (a == "--min-corner-gradient" && i + 1 < argc)
       o.klt.min_corner_gradient = std::atof(argv[++i]);
     else if (a == "--min-corner-isotropy" && i + 1 < argc)
@@ -250,6 +295,7 @@ int run(int argc, char** argv) {
     else if (a == "--no-predict") o.klt.predict_motion = false;
     else if (a == "--drop-leaving") o.klt.drop_leaving = true;
     else if (a == "--redetect-alternate") o.klt.redetect_alternate = true;
+    else if (a == "--redetect-lost-cells") o.klt.redetect_lost_cells = true;
     else if (a == "--strongest-first") o.klt.strongest_first = true;
     else if (a == "--no-strongest-first") o.klt.strongest_first = false;
     else if (a == "--weak-corner-gradient" && i + 1 < argc)
@@ -425,6 +471,9 @@ int run(int argc, char** argv) {
       stereo_ms, scaled, cpu, caller_cpu, worker_cpu, longest_cpu, line_matches, line_inliers,
       tracked, started, junctions, junction_inliers, vp_matches, vp_inliers;
   int ok = 0, rotation_only = 0, answered_frames = 0;
+  int segment_detections = 0;  // frames whose segments were detected
+  // Every estimated pair's point matches and junctions: their Sampson error under the truth.
+  std::vector<double> point_truth_px, junction_truth_px;
   // Keyframes, and the answered frames a second after the first and those of them with a baseline.
   int keyframes = 1, late_answers = 0, late_baselines = 0, late_translations = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
@@ -443,6 +492,7 @@ int run(int argc, char** argv) {
     if (stereo) input.right_image = right_images[i];
     const double cpu_start = cpu_ms();
     const VisualOdometryResult r = vo.process(input);
+    segment_detections += r.line_tracking.detected;
     {
       evaluation::StampedPose p;
       p.stamp = input.stamp;
@@ -474,6 +524,17 @@ int run(int argc, char** argv) {
           const RelativePose truth_pose{b.R_wc.transpose() * a.R_wc,
                                         b.R_wc.transpose() * (a.c_w - b.c_w)};
           pair_rot_deg.push_back(rotation_error(r.motion.R, truth_pose.R) * 180.0 / M_PI);
+          // The matches' quality: their distance to the true epipolar geometry (Sampson, px).
+          for (const PointMatch& m : r.matches.points) {
+            const double e = sampson_error_px(input.camera.pinhole, input.camera.pinhole,
+                                              truth_pose, m.x1, m.x2);
+            if (std::isfinite(e)) point_truth_px.push_back(e);
+          }
+          for (const DerivedPoint& j : r.estimate.estimate.junctions) {
+            const double e = sampson_error_px(input.camera.pinhole, input.camera.pinhole,
+                                              truth_pose, j.match.x1, j.match.x2);
+            if (std::isfinite(e)) junction_truth_px.push_back(e);
+          }
           // The motion and covariance the node publishes on ~relative_pose.
           const Eigen::Matrix<double, 6, 6>& C = r.motion_covariance;
           const bool valid = r.motion_covariance_valid;
@@ -798,6 +859,25 @@ int run(int argc, char** argv) {
               "found %.0f, started %.0f; line inlier ratio %.3f of %.0f (pooled)\n",
               median(line_matches), median(line_inliers), median(tracked), median(started),
               lines_sum > 0.0 ? inliers_sum / lines_sum : 0.0, lines_sum);
+  std::printf("segments detected in %d of %d frames\n", segment_detections, frames);
+  if (!point_truth_px.empty())
+    std::printf("matches under the true epipolar geometry (Sampson px, median / p90 / share "
+                "beyond 2 px): points %.3f / %.3f / %.1f %% of %zu, junctions %.3f / %.3f / "
+                "%.1f %% of %zu\n",
+                median(point_truth_px), percentile(point_truth_px, 0.9),
+                100.0 * std::count_if(point_truth_px.begin(), point_truth_px.end(),
+                                      [](double e) { return e > 2.0; }) /
+                    point_truth_px.size(),
+                point_truth_px.size(),
+                junction_truth_px.empty() ? NAN : median(junction_truth_px),
+                junction_truth_px.empty() ? NAN : percentile(junction_truth_px, 0.9),
+                junction_truth_px.empty()
+                    ? NAN
+                    : 100.0 *
+                          std::count_if(junction_truth_px.begin(), junction_truth_px.end(),
+                                        [](double e) { return e > 2.0; }) /
+                          junction_truth_px.size(),
+                junction_truth_px.size());
   std::printf("median per estimated frame: junctions %.0f (%.0f inliers), VPs %.0f (%.0f "
               "inliers)\n",
               median(junctions), median(junction_inliers), median(vp_matches),

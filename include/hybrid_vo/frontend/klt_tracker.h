@@ -84,6 +84,10 @@ struct KltTrackerOptions {
   // rendered corridor move (doc/performance.md#a-cpu-budget-issue-44): the CPU budget's first
   // level, not yet the default.
   bool redetect_alternate = false;
+  // Re-detection only in the cells that lost tracks since the last frame's (or never held any):
+  // where an image has fewer good corners than max_features (a room's walls) a cell stays short
+  // of its quota, and looking again every frame finds the corners it passed over before.
+  bool redetect_lost_cells = false;
 };
 
 // What the tracks cost and how long they live, since the tracker was made (resets included): the
@@ -125,6 +129,7 @@ void visit_fields(KltTrackerOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(positive_fraction(), o.quality_level);
   HYBRID_VO_FIELDS(at_least(5), o.window_px);  // smaller windows lose the texture
   HYBRID_VO_FIELDS(any_value(), o.predict_motion, o.drop_leaving, o.redetect_alternate,
+                  o.redetect_lost_cells,
                   o.strongest_first);
 }
 
@@ -151,6 +156,12 @@ class KltTracker {
   std::vector<PointMatch> track_existing(const GrayImage& image, std::vector<int64_t>* ids = nullptr,
                                          double stamp = kNoStamp,
                                          const ParallelFor& parallel = {});
+  // track_existing on the pyramid of the image (build_pyramid), built by the caller so that it
+  // serves the frame's other stages too (segments, stereo): one pyramid per frame.
+  std::vector<cv::Mat> build_pyramid(const GrayImage& image) const;
+  std::vector<PointMatch> track_pyramid(std::vector<cv::Mat> pyramid,
+                                        std::vector<int64_t>* ids = nullptr,
+                                        double stamp = kNoStamp, const ParallelFor& parallel = {});
   // Fills the buckets of the last tracked image that have too few features; appends to points().
   void detect_new(const ParallelFor& parallel = {});
   // detect_new in three steps, so that a caller can run the cells beside other work: the grid,
@@ -190,6 +201,8 @@ class KltTracker {
   int max_features_;
   int64_t detections_ = 0;  // re-detections added since the last reset (redetect_alternate)
   int refilled_to_ = 0;     // the tracks after the last re-detection that looked for corners
+  // Per grid cell: its tracks after the last frame's re-detection (redetect_lost_cells).
+  std::vector<int> cell_tracks_;
   cv::Size size_;
   std::vector<cv::Mat> previous_;  // image pyramid with derivatives, built once per frame
   std::vector<cv::Point2f> points_;

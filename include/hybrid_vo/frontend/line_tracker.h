@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "hybrid_vo/frontend/line_matching.h"
+#include "hybrid_vo/frontend/segment_motion.h"
 
 namespace hybrid_vo {
 
@@ -49,7 +50,8 @@ struct LineTrackingStats {
   int ambiguous = 0;  // of those, told apart by the descriptor
   int reidentified = 0;  // of those, found by descriptor matching after the search
   int started = 0;    // new tracks from this frame's unmatched segments
-  int dropped = 0;    // tracks missed for more than max_missed_frames
+  int dropped = 0;    // tracks missed for more than max_missed_frames (line flow: lost, merged)
+  bool detected = false;  // the frame's segments were detected (line flow: where tracks thin out)
 };
 
 class LineTracker {
@@ -81,16 +83,10 @@ class LineTracker {
     LineSegment segment;  // where it was last seen (oriented), or predicted while it coasts
     cv::Mat descriptor;   // its LBD row when last seen, or empty
     double seen_at = 0.0;  // the time of `segment`
-    // Image motion per unit of time beyond the camera's rotation: the shift of the line along its
-    // normal at the midpoint and the turn of its direction; unknown until seen twice.
-    bool has_motion = false;
-    Eigen::Vector2d shift = Eigen::Vector2d::Zero();
-    double turn = 0.0;
+    // Image motion per unit of time beyond the camera's rotation (segment_motion.h).
+    SegmentMotion motion;
     int missed = 0;  // frames in a row without a match
   };
-  // Where track t lies at time `now`, its segment first carried by `image_motion`.
-  static LineSegment predict(const Track& t, double now, const Eigen::Matrix3d& image_motion);
-
   // One frame's search (track's steps): per track its prediction, its segment carried by the
   // rotation alone and the segment it found (-1: none); per segment its track (-1: none).
   struct Search {

@@ -14,6 +14,7 @@
 #include "hybrid_vo/frontend/frontend.h"
 #include "hybrid_vo/frontend/cpu_budget.h"
 #include "hybrid_vo/frontend/klt_tracker.h"
+#include "hybrid_vo/frontend/line_flow_tracker.h"
 #include "hybrid_vo/frontend/line_tracker.h"
 #include "hybrid_vo/frontend/stage_timings.h"
 #include "hybrid_vo/estimation/rotation_only.h"
@@ -45,6 +46,11 @@ struct VisualOdometryOptions {
   // keyframe's by track id; false: the keyframe's segments matched by LBD in every frame.
   bool track_lines = true;
   LineTrackerOptions line_tracking;
+  // With track_lines: the segments followed from frame to frame by their flow and detected only
+  // where their tracks thin out (LineFlowTracker, issue 57); false: detected and described in
+  // every frame and tracked by their geometry (LineTracker).
+  bool line_flow = false;
+  LineFlowTrackerOptions line_flow_tracking;
   // The segments and the stereo matching on a second thread, beside the points and the
   // estimator. The results do not depend on it.
   bool concurrent = true;
@@ -151,7 +157,7 @@ struct VisualOdometryOptions {
 // the node sets.
 template <typename Visit>
 void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
-  HYBRID_VO_FIELDS(any_value(), o.use_lines, o.track_lines, o.concurrent,
+  HYBRID_VO_FIELDS(any_value(), o.use_lines, o.track_lines, o.line_flow, o.concurrent,
                   o.stereo_current_disparity, o.stereo_refine_tracks, o.use_direction_map,
                   o.anchor_orientation);
   visit("max_features", o.features.points.max_features, positive());
@@ -365,7 +371,15 @@ class VisualOdometry {
 
   // vo_tracking.cc: the frame's points and segments, their matches with the keyframe's, and the
   // KLT re-detection for the next frame.
+  // The frame's image pyramid, which the KLT tracker, the segments' flow and the stereo
+  // matching share (built when one of them needs it).
+  void build_pyramid(Frame& f) const;
   void track_segments(Frame& f);      // detected, described and tracked (the second thread)
+  // line_flow: the frame's segments detected on the second thread where the tracks want them,
+  // beside the points; then, once the points are tracked, the tracks followed by the flow (on
+  // both threads) and the detections taken on.
+  void start_segment_detection(Frame& f);
+  void follow_segments(Frame& f);
   void track_points(Frame& f);        // KLT (searches on both threads), external or descriptors
   void match_points(Frame& f) const;  // with the keyframe's, and the parallax
   void start_redetection(Frame& f);   // its cells shared by both threads
@@ -476,6 +490,7 @@ class VisualOdometry {
   std::unique_ptr<WorkerThread> worker_;
   KltTracker klt_;
   LineTracker line_tracker_;
+  LineFlowTracker line_flow_;
   VoOrientation orientation_;
   // Kept across reset(): the offset belongs to the rig, not to the trajectory.
   DisparityOffsetFilter offset_filter_;
