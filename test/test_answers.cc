@@ -13,8 +13,8 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
-#include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/pose_error.h"
+#include "hybrid_vo/odometry/visual_odometry.h"
 #include "hybrid_vo/render/pan_motion.h"
 #include "hybrid_vo/render/photo_pan.h"
 #include "hybrid_vo/render/sequence.h"

@@ -36,7 +36,7 @@
 #include "hybrid_vo/conversion/lamar_to_bag.h"
 #include "hybrid_vo/datasets/kitti.h"
 #include "hybrid_vo/datasets/readers.h"
-#include "hybrid_vo/frontend/image_codec.h"
+#include "hybrid_vo/features/image_codec.h"
 #include "hybrid_vo/render/sequence.h"
 
 namespace hybrid_vo {

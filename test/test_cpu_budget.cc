@@ -1,4 +1,4 @@
-// The CPU budget's controller (frontend/cpu_budget.h): no budget keeps the fixed level; frames
+// The CPU budget's controller (odometry/cpu_budget.h): no budget keeps the fixed level; frames
 // over the budget raise the level a step at a time, each after the last had time to show; frames
 // that would fit the level below lower it again after a while; nonsense times are ignored.
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "hybrid_vo/frontend/cpu_budget.h"
+#include "hybrid_vo/odometry/cpu_budget.h"
 
 namespace {
 

@@ -15,10 +15,10 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "hybrid_vo/frontend/camera_model.h"
-#include "hybrid_vo/frontend/fisheye_rectifier.h"
-#include "hybrid_vo/frontend/line_matching.h"
-#include "hybrid_vo/frontend/point_matching.h"
+#include "hybrid_vo/features/camera_model.h"
+#include "hybrid_vo/features/fisheye_rectifier.h"
+#include "hybrid_vo/features/line_matching.h"
+#include "hybrid_vo/features/point_matching.h"
 
 namespace hybrid_vo {
 namespace {

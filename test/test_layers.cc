@@ -1,8 +1,12 @@
 // Which folder may include which, checked on the sources themselves (doc/development.md, Layout).
 //   - The core (geometry, solvers, estimation, lines, direction_map, synthetic) links Eigen and
 //     Ceres only, and each layer includes only the layers before it (DESIGN.md: geometry <-
-//     solvers <- estimation <- lines <- direction_map <- frontend <- node); synthetic data may use
-//     all of the core.
+//     solvers <- estimation <- lines <- direction_map <- features <- odometry <- node); synthetic
+//     data may use all of the core.
+//   - The front end is the OpenCV layer, in two folders with a one-way arrow: features (the image
+//     features: detection, description, matching, tracking, stereo, camera models) may use the
+//     core and OpenCV; odometry (VisualOdometry and the policies that schedule the features) may
+//     also use features. Nothing in features uses odometry.
 //   - datasets, render and evaluation may use the core, the front end and OpenCV; conversion may
 //     also use datasets, render (the bag's camera frames are the renderer's) and ROS (rosbag and
 //     messages). Nothing in the core, the front end or the node uses any of the four.
@@ -46,7 +50,9 @@ std::set<std::string> operator+(std::set<std::string> a, const std::set<std::str
 
 const std::set<std::string> kCore = {"geometry", "solvers",       "estimation",
                                       "lines",    "direction_map", "synthetic"};
-const std::set<std::string> kOpenCvLibrary = kCore + std::set<std::string>{"frontend", "opencv"};
+// The front end: features, and odometry above it (odometry may use features, not the reverse).
+const std::set<std::string> kFeatures = kCore + std::set<std::string>{"features", "opencv"};
+const std::set<std::string> kOpenCvLibrary = kFeatures + std::set<std::string>{"odometry"};
 
 // Per folder (under src/ and include/hybrid_vo/ alike), what its files may include.
 const std::map<std::string, std::set<std::string>> kRules = {
@@ -56,7 +62,8 @@ const std::map<std::string, std::set<std::string>> kRules = {
     {"lines", {"geometry", "solvers", "estimation", "lines"}},
     {"direction_map", {"geometry", "solvers", "estimation", "lines", "direction_map"}},
     {"synthetic", kCore},
-    {"frontend", kOpenCvLibrary},
+    {"features", kFeatures},
+    {"odometry", kOpenCvLibrary},
     {"node", kOpenCvLibrary + std::set<std::string>{"node", "messages", "ros"}},
     {"nodes", kOpenCvLibrary + std::set<std::string>{"node", "messages", "ros"}},
     {"datasets", kOpenCvLibrary + std::set<std::string>{"datasets"}},
@@ -154,7 +161,8 @@ TEST(Layers, SourceTreeKeepsTheRules) {
 // The rules themselves: every folder of the source tree has one (an unknown folder fails above),
 // and the ones the issue names hold.
 TEST(Layers, RulesKeepTheLibrariesOutOfTheCoreAndTheFrontEnd) {
-  for (const std::string& folder : kCore + std::set<std::string>{"frontend", "node", "python"})
+  for (const std::string& folder :
+       kCore + std::set<std::string>{"features", "odometry", "node", "python"})
     for (const char* library : {"datasets", "render", "evaluation", "conversion", "tools"})
       EXPECT_FALSE(kRules.at(folder).count(library)) << folder << " may use " << library;
   for (const std::string& folder : kCore)
@@ -162,6 +170,9 @@ TEST(Layers, RulesKeepTheLibrariesOutOfTheCoreAndTheFrontEnd) {
       EXPECT_FALSE(kRules.at(folder).count(external)) << folder << " may use " << external;
   for (const char* library : {"datasets", "render", "evaluation"})
     EXPECT_FALSE(kRules.at(library).count("ros")) << library << " may use ROS";
+  // The arrow between the front end's two folders points one way only.
+  EXPECT_TRUE(kRules.at("odometry").count("features"));
+  EXPECT_FALSE(kRules.at("features").count("odometry"));
   EXPECT_TRUE(kRules.at("conversion").count("datasets"));
   EXPECT_TRUE(kRules.at("conversion").count("ros"));
 }
@@ -180,10 +191,13 @@ class LayersSelfCheck : public ::testing::TestWithParam<BadTree> {};
 TEST_P(LayersSelfCheck, ReportsTheViolation) {
   const BadTree& bad = GetParam();
   TempDir dir("hybrid_vo_layers");
-  // A clean base: a core header, a front end source, a conversion source and a main.
+  // A clean base: a core header, the front end's sources (features, and odometry using them), a
+  // conversion source and a main.
   write_file(dir.path() / "include/hybrid_vo/geometry/pose.h", "#include <Eigen/Core>\n");
-  write_file(dir.path() / "src/frontend/frontend.cc",
+  write_file(dir.path() / "src/features/frontend.cc",
              "#include <opencv2/core.hpp>\n#include \"hybrid_vo/geometry/pose.h\"\n");
+  write_file(dir.path() / "src/odometry/visual_odometry.cc",
+             "#include <opencv2/core.hpp>\n#include \"hybrid_vo/features/frontend.h\"\n");
   write_file(dir.path() / "src/conversion/bag.cc",
              "#include <rosbag/bag.h>\n#include \"hybrid_vo/datasets/kitti.h\"\n");
   write_file(dir.path() / "src/tools/tool.cc",
@@ -208,8 +222,12 @@ INSTANTIATE_TEST_SUITE_P(
                 "#include \"hybrid_vo/solvers/relpose_5pt.h\"\n", "geometry may not use solvers"},
         BadTree{"core uses OpenCV", "src/lines/vp.cc", "#include <opencv2/core.hpp>\n",
                 "lines may not use opencv"},
-        BadTree{"front end uses datasets", "src/frontend/camera.cc",
-                "#include \"hybrid_vo/datasets/sequence.h\"\n", "frontend may not use datasets"},
+        BadTree{"features use datasets", "src/features/camera.cc",
+                "#include \"hybrid_vo/datasets/sequence.h\"\n", "features may not use datasets"},
+        BadTree{"odometry uses datasets", "src/odometry/keyframes.cc",
+                "#include \"hybrid_vo/datasets/sequence.h\"\n", "odometry may not use datasets"},
+        BadTree{"features use odometry", "include/hybrid_vo/features/klt_tracker.h",
+                "#include \"hybrid_vo/odometry/cpu_budget.h\"\n", "features may not use odometry"},
         BadTree{"node uses render", "src/node/node.cc", "#include \"hybrid_vo/render/scene.h\"\n",
                 "node may not use render"},
         BadTree{"evaluation uses ROS", "src/evaluation/plot.cc", "#include <ros/time.h>\n",

@@ -12,7 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "hybrid_vo/frontend/image_codec.h"
+#include "hybrid_vo/features/image_codec.h"
 #include "hybrid_vo/node/compressed_image.h"
 #include "hybrid_vo/node/frame_queue.h"
 #include "hybrid_vo/node/latency_window.h"

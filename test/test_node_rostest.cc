@@ -25,9 +25,9 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "hybrid_vo/frontend/cpu_budget.h"
 #include "hybrid_vo/geometry/pose_covariance.h"
 #include "hybrid_vo/geometry/pose_error.h"
+#include "hybrid_vo/odometry/cpu_budget.h"
 #include "hybrid_vo/render/sequence.h"
 #include "node_test_utils.h"
 

@@ -18,7 +18,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "hybrid_vo/frontend/fisheye_rectifier.h"
+#include "hybrid_vo/features/fisheye_rectifier.h"
 #include "hybrid_vo/render/sequence.h"
 
 namespace {
@@ -1205,7 +1205,7 @@ TEST_F(FisheyeRenderTest, PaintedCornersProjectThroughTheLens) {
 }
 
 // Two independent paths to the same picture: the fisheye view rectified into a 100-degree pinhole
-// view (frontend/fisheye_rectifier.h) against the pinhole renderer's view of that camera. Where
+// view (features/fisheye_rectifier.h) against the pinhole renderer's view of that camera. Where
 // the fisheye resolves at least as finely as the view (the middle), they agree to a few grey
 // levels and without a shift.
 TEST_F(FisheyeRenderTest, RectifiedViewIsThePinholeRenderersView) {

@@ -11,8 +11,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "hybrid_vo/frontend/line_flow_tracker.h"
-#include "hybrid_vo/frontend/segment_flow.h"
+#include "hybrid_vo/features/line_flow_tracker.h"
+#include "hybrid_vo/features/segment_flow.h"
 #include "image_test_utils.h"
 
 namespace {

@@ -1,7 +1,7 @@
 // Stereo scale (estimation/stereo_scale) and the metric motion from stereo points
 // (estimation/stereo_motion) on synthetic highway-like scenes, stereo matching
-// (frontend/stereo) on a rendered pair with known depth and split over threads, and the affine
-// refinement of the scale's current points (frontend/affine_tracking) on a synthetic
+// (features/stereo) on a rendered pair with known depth and split over threads, and the affine
+// refinement of the scale's current points (features/affine_tracking) on a synthetic
 // approaching plane.
 #include <algorithm>
 #include <cmath>
@@ -15,11 +15,11 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "hybrid_vo/estimation/stereo_scale.h"
 #include "hybrid_vo/estimation/stereo_motion.h"
-#include "hybrid_vo/frontend/affine_tracking.h"
-#include "hybrid_vo/frontend/stereo.h"
-#include "hybrid_vo/frontend/worker_thread.h"
+#include "hybrid_vo/estimation/stereo_scale.h"
+#include "hybrid_vo/features/affine_tracking.h"
+#include "hybrid_vo/features/stereo.h"
+#include "hybrid_vo/features/worker_thread.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/geometry/rotation.h"

@@ -20,12 +20,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "hybrid_vo/estimation/relative_pose_estimator.h"
-#include "hybrid_vo/frontend/klt_tracker.h"
-#include "hybrid_vo/frontend/line_tracker.h"
-#include "hybrid_vo/frontend/visual_odometry.h"
-#include "hybrid_vo/frontend/worker_thread.h"
+#include "hybrid_vo/features/klt_tracker.h"
+#include "hybrid_vo/features/line_tracker.h"
+#include "hybrid_vo/features/worker_thread.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/geometry/pose_covariance.h"
+#include "hybrid_vo/odometry/visual_odometry.h"
 #include "hybrid_vo/render/renderer.h"
 #include "hybrid_vo/render/sequence.h"
 #include "image_test_utils.h"

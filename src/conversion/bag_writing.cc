@@ -19,7 +19,7 @@
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_msgs/TFMessage.h>
 
-#include "hybrid_vo/frontend/image_codec.h"
+#include "hybrid_vo/features/image_codec.h"
 
 namespace hybrid_vo {
 namespace conversion {

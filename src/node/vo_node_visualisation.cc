@@ -6,7 +6,7 @@
 #include <cv_bridge/cv_bridge.h>
 #include <visualization_msgs/MarkerArray.h>
 
-#include "hybrid_vo/frontend/visualization.h"
+#include "hybrid_vo/features/visualization.h"
 #include "hybrid_vo/node/conversions.h"
 #include "hybrid_vo/node/vo_node.h"
 

@@ -7,7 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "arguments.h"
-#include "hybrid_vo/frontend/frontend.h"
+#include "hybrid_vo/features/frontend.h"
 
 namespace hybrid_vo::python {
 namespace {

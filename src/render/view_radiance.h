@@ -5,7 +5,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "hybrid_vo/frontend/camera_model.h"
+#include "hybrid_vo/features/camera_model.h"
 #include "hybrid_vo/render/renderer.h"
 
 namespace hybrid_vo {
@@ -23,7 +23,7 @@ ViewRadiance pinhole_radiance(const Scene& scene, const PinholeCamera& camera,
                               bool with_geometry);
 
 // Of an equidistant (fisheye) camera (fisheye_view.cc): every sample's ray is cast through the
-// lens model (frontend/camera_model.h), also beyond 90 degrees off the axis, and shaded as the
+// lens model (features/camera_model.h), also beyond 90 degrees off the axis, and shaded as the
 // pinhole view's are; depth is the surface's camera z (negative behind the image plane), quad_id
 // -1 where a ray meets nothing or the lens has none.
 ViewRadiance equidistant_radiance(const Scene& scene, const CameraModel& camera,

@@ -28,11 +28,11 @@
 #include "hybrid_vo/evaluation/consistency.h"
 #include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/evaluation/trajectory.h"
-#include "hybrid_vo/frontend/frontend.h"
-#include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/features/frontend.h"
 #include "hybrid_vo/geometry/epipolar_error.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/node/parameters_file.h"
+#include "hybrid_vo/odometry/visual_odometry.h"
 
 namespace hybrid_vo {
 namespace {

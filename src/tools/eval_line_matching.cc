@@ -19,7 +19,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "hybrid_vo/frontend/line_matching.h"
+#include "hybrid_vo/features/line_matching.h"
 
 namespace {
 

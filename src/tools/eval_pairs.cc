@@ -21,7 +21,7 @@
 #include "hybrid_vo/evaluation/ground_truth_check.h"
 #include "hybrid_vo/evaluation/opencv_baseline.h"
 #include "hybrid_vo/evaluation/statistics.h"
-#include "hybrid_vo/frontend/frontend.h"
+#include "hybrid_vo/features/frontend.h"
 #include "hybrid_vo/geometry/pose_error.h"
 #include "hybrid_vo/lines/two_view.h"
 

@@ -27,9 +27,9 @@
 #include "hybrid_vo/evaluation/command_line.h"
 #include "hybrid_vo/evaluation/statistics.h"
 #include "hybrid_vo/evaluation/trajectory.h"
-#include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/homogeneous.h"
 #include "hybrid_vo/node/conversions.h"
+#include "hybrid_vo/odometry/visual_odometry.h"
 #include "hybrid_vo/render/renderer.h"
 #include "hybrid_vo/render/scene.h"
 

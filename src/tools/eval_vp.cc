@@ -11,7 +11,7 @@
 
 #include "hybrid_vo/datasets/york_urban.h"
 #include "hybrid_vo/evaluation/statistics.h"
-#include "hybrid_vo/frontend/line_detection.h"
+#include "hybrid_vo/features/line_detection.h"
 #include "hybrid_vo/lines/vp_detection.h"
 
 namespace {

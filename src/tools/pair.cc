@@ -6,8 +6,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "hybrid_vo/evaluation/command_line.h"
-#include "hybrid_vo/frontend/frontend.h"
-#include "hybrid_vo/frontend/visualization.h"
+#include "hybrid_vo/features/frontend.h"
+#include "hybrid_vo/features/visualization.h"
 #include "hybrid_vo/lines/two_view.h"
 
 namespace {

@@ -9,7 +9,7 @@
 
 #include <Eigen/Core>
 
-#include "hybrid_vo/frontend/camera_model.h"
+#include "hybrid_vo/features/camera_model.h"
 #include "hybrid_vo/geometry/pose.h"
 
 namespace hybrid_vo {

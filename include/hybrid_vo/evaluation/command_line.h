@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_vo/frontend/camera_model.h"
+#include "hybrid_vo/features/camera_model.h"
 
 namespace hybrid_vo {
 namespace evaluation {

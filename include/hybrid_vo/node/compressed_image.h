@@ -2,14 +2,14 @@
 
 // sensor_msgs/CompressedImage to the front end's 8-bit grey image, without the
 // compressed_image_transport plugin (Debian ships none): the node subscribes <image>/compressed
-// itself with `image_transport: compressed` and decodes here (frontend/image_codec.h).
+// itself with `image_transport: compressed` and decodes here (features/image_codec.h).
 
 #include <string>
 
 #include <opencv2/core.hpp>
 #include <sensor_msgs/CompressedImage.h>
 
-#include "hybrid_vo/frontend/image_codec.h"
+#include "hybrid_vo/features/image_codec.h"
 
 namespace hybrid_vo {
 

@@ -14,7 +14,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud.h>
 
-#include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/odometry/visual_odometry.h"
 
 namespace hybrid_vo {
 

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "hybrid_vo/frontend/visual_odometry.h"
 #include "hybrid_vo/geometry/option_fields.h"
 #include "hybrid_vo/node/stream_monitor.h"
+#include "hybrid_vo/odometry/visual_odometry.h"
 
 namespace hybrid_vo {
 

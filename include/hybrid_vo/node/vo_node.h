@@ -31,13 +31,13 @@
 #include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/Marker.h>
 
-#include "hybrid_vo/frontend/fisheye_rectifier.h"
-#include "hybrid_vo/frontend/visual_odometry.h"
+#include "hybrid_vo/features/fisheye_rectifier.h"
 #include "hybrid_vo/node/frame_queue.h"
 #include "hybrid_vo/node/injected_leak.h"
 #include "hybrid_vo/node/latency_window.h"
 #include "hybrid_vo/node/node_parameters.h"
 #include "hybrid_vo/node/stream_monitor.h"
+#include "hybrid_vo/odometry/visual_odometry.h"
 
 namespace hybrid_vo {
 

@@ -16,7 +16,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "hybrid_vo/frontend/camera_model.h"
+#include "hybrid_vo/features/camera_model.h"
 #include "hybrid_vo/geometry/camera.h"
 #include "hybrid_vo/render/camera_path.h"
 #include "hybrid_vo/render/scene.h"
