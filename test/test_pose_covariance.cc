@@ -110,6 +110,15 @@ struct Pair {
   Eigen::Matrix3d drift = Eigen::Matrix3d::Zero();
 };
 
+// A random pair of a chain: a turn of about 0.15 rad, a unit-sized step, its covariance.
+Pair random_pair(std::mt19937_64& rng) {
+  Pair p;
+  p.R = exp_so3(normal3(rng, 0.15));
+  p.t = normal3(rng);
+  p.covariance = random_covariance(rng, 2e-3, 2e-2);
+  return p;
+}
+
 // The accumulated pose covariance of a random chain of `steps` pairs, from
 // propagate_pose_covariance and from a Monte-Carlo run of the chain itself; returns their
 // relative difference.
@@ -123,10 +132,7 @@ double chain_against_monte_carlo(uint64_t seed, FilterStep mode, int steps, int 
   Eigen::Matrix3d R_wc = exp_so3(normal3(rng, 0.5));
   const Eigen::Matrix3d R_wc0 = R_wc;
   for (int k = 0; k < steps; ++k) {
-    Pair& p = pairs[k];
-    p.R = exp_so3(normal3(rng, 0.15));
-    p.t = normal3(rng);
-    p.covariance = random_covariance(rng, 2e-3, 2e-2);
+    Pair& p = pairs[k] = random_pair(rng);
     R_wc = R_wc * p.R.transpose();
     const Eigen::Matrix3d predicted = analytic.bottomRightCorner<3, 3>() +
                                       R_wc * p.covariance.topLeftCorner<3, 3>() *
@@ -286,10 +292,7 @@ TEST(PoseCovariance, ScaledChainMatchesMonteCarlo) {
     Eigen::Matrix3d R_wc = exp_so3(normal3(rng, 0.5));
     const Eigen::Matrix3d R_wc0 = R_wc;
     for (int k = 0; k < steps; ++k) {
-      Pair& p = pairs[k];
-      p.R = exp_so3(normal3(rng, 0.15));
-      p.t = normal3(rng);
-      p.covariance = random_covariance(rng, 2e-3, 2e-2);
+      Pair& p = pairs[k] = random_pair(rng);
       hands_on[k] = k % 3 != 2;
       R_wc = R_wc * p.R.transpose();
       const Eigen::Matrix3d predicted = analytic.block<3, 3>(3, 3) +
