@@ -637,6 +637,34 @@ int run(int argc, char** argv) {
                           : NAN,
                       (gt[i].c_w - gt[reference].c_w).norm(),
                       r.mono_scale_points, r.window_scale_points, r.message.c_str());
+          // Does the estimator's pose fit its own inliers as well as the truth does? Where the
+          // truth fits them better, something other than their noise moved the pose.
+          const RelativePoseEstimate& est = r.estimate.estimate;
+          const auto& cam = input.camera.pinhole;
+          const RelativePose truth_pose{gt[i].R_wc.transpose() * gt[reference].R_wc,
+                                        gt[i].R_wc.transpose() * (gt[reference].c_w - gt[i].c_w)};
+          std::vector<double> pe, pt, je, jt;
+          for (size_t k = 0; k < r.matches.points.size() && k < est.point_inliers.size(); ++k) {
+            if (!est.point_inliers[k]) continue;
+            const PointMatch& m = r.matches.points[k];
+            pe.push_back(sampson_error_px(cam, cam, est.pose, m.x1, m.x2));
+            pt.push_back(sampson_error_px(cam, cam, truth_pose, m.x1, m.x2));
+          }
+          for (size_t k = 0; k < est.junctions.size() && k < est.junction_inliers.size(); ++k) {
+            if (!est.junction_inliers[k]) continue;
+            const DerivedPoint& j = est.junctions[k];
+            je.push_back(sampson_error_px(cam, cam, est.pose, j.match.x1, j.match.x2));
+            jt.push_back(sampson_error_px(cam, cam, truth_pose, j.match.x1, j.match.x2));
+          }
+          const auto median = [](std::vector<double> v) {
+            if (v.empty()) return static_cast<double>(NAN);
+            std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+            return v[v.size() / 2];
+          };
+          std::printf("   inliers' Sampson median (px) under the estimator's pose / the truth: "
+                      "points %.3f / %.3f (%zu), junctions %.3f / %.3f (%zu)%s\n",
+                      median(pe), median(pt), pe.size(), median(je), median(jt), je.size(),
+                      est.refined ? "" : "; not refined (the refinement lost inliers)");
         }
       }
     }
