@@ -55,7 +55,7 @@ CornerStrength corner_strength(const cv::Mat& gray, const cv::Point2f& p, int wi
     const uchar* above = gray.ptr<uchar>(y - 1);
     const uchar* row = gray.ptr<uchar>(y);
     const uchar* below = gray.ptr<uchar>(y + 1);
-    // A row's sums fit an int (each product is at most 1020^2) for windows narrower than 2000.
+    // A row's sums fit an int: each product is at most 1020^2, and window_px at most 401.
     int row_xx = 0, row_xy = 0, row_yy = 0;
     for (int x = box.x + 1; x < box.x + box.width - 1; ++x) {
       const int gx = (above[x + 1] + 2 * row[x + 1] + below[x + 1]) -

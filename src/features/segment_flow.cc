@@ -54,7 +54,8 @@ float normalise(const float* values, int count, float* out) {
 }
 
 // The normalised correlations of a normalised template (count values) with `window` at the
-// offsets 0 .. offsets - 1 (at most kMaxOffsets). The offsets are the inner loop, so that it
+// offsets 0 .. offsets - 1 (at most kMaxOffsets: track_segments_by_flow takes no search_px
+// beyond 40, 81 offsets). The offsets are the inner loop, so that it
 // vectorises; each offset's sums still run over k in order, as one offset's loop would.
 constexpr int kMaxOffsets = 96;
 void correlations(const float* normalised, const float* window, int count, int offsets,
