@@ -183,7 +183,8 @@ TEST(NodeParameters, BadValuesAndUnknownNamesAreReportedAndKeepTheDefault) {
   };
   const std::vector<Bad> bad = {
       {"vp_min_inliers", 1, "must be >= 2"},
-      {"klt_window_px", 3, "must be >= 5"},
+      {"klt_window_px", 3, "must be in [5, 401]"},
+      {"klt_window_px", 402, "must be in [5, 401]"},
       {"frame_queue_size", 0, "must be >= 1"},
       {"rectified_fov_deg", 5.0, "must be in [10, 170]"},
       {"max_frame_gap", 0.0, "must be > 0"},

@@ -6,6 +6,22 @@
 #include "hybrid_vo/geometry/homogeneous.h"
 
 namespace hybrid_vo {
+namespace {
+
+// The squared Sampson error, inlined into the scoring loops (millions of calls a sequence).
+inline double sampson_squared(const Eigen::Matrix3d& F, const Eigen::Vector2d& a,
+                              const Eigen::Vector2d& b) {
+  const double f0 = F(0, 0) * a.x() + F(0, 1) * a.y() + F(0, 2);
+  const double f1 = F(1, 0) * a.x() + F(1, 1) * a.y() + F(1, 2);
+  const double f2 = F(2, 0) * a.x() + F(2, 1) * a.y() + F(2, 2);
+  const double g0 = F(0, 0) * b.x() + F(1, 0) * b.y() + F(2, 0);
+  const double g1 = F(0, 1) * b.x() + F(1, 1) * b.y() + F(2, 1);
+  const double c = b.x() * f0 + b.y() * f1 + f2;
+  const double d = f0 * f0 + f1 * f1 + g0 * g0 + g1 * g1;
+  return d > 0.0 ? c * c / d : (c == 0.0 ? 0.0 : INFINITY);
+}
+
+}  // namespace
 
 ModelScorer::ModelScorer(const HybridProblem& problem, double point_threshold_px,
                          double vp_threshold_rad)
@@ -20,19 +36,12 @@ Eigen::Matrix3d ModelScorer::fundamental(const RelativePose& pose) const {
 }
 
 double ModelScorer::squared_sampson(const Eigen::Matrix3d& F, int i) const {
-  return squared_sampson(F, problem_.px1[i], problem_.px2[i]);
+  return sampson_squared(F, problem_.px1[i], problem_.px2[i]);
 }
 
 double ModelScorer::squared_sampson(const Eigen::Matrix3d& F, const Eigen::Vector2d& a,
                                     const Eigen::Vector2d& b) const {
-  const double f0 = F(0, 0) * a.x() + F(0, 1) * a.y() + F(0, 2);
-  const double f1 = F(1, 0) * a.x() + F(1, 1) * a.y() + F(1, 2);
-  const double f2 = F(2, 0) * a.x() + F(2, 1) * a.y() + F(2, 2);
-  const double g0 = F(0, 0) * b.x() + F(1, 0) * b.y() + F(2, 0);
-  const double g1 = F(0, 1) * b.x() + F(1, 1) * b.y() + F(2, 1);
-  const double c = b.x() * f0 + b.y() * f1 + f2;
-  const double d = f0 * f0 + f1 * f1 + g0 * g0 + g1 * g1;
-  return d > 0.0 ? c * c / d : (c == 0.0 ? 0.0 : INFINITY);
+  return sampson_squared(F, a, b);
 }
 
 double ModelScorer::vp_angle(const Eigen::Matrix3d& R, int k) const {
@@ -55,7 +64,8 @@ double ModelScorer::cost(const RelativePose& pose, double bound) const {
   for (int start = 0; start < n && total <= bound; start += 64) {
     const int end = std::min(n, start + 64);
     for (int i = start; i < end; ++i)
-      total += std::min(squared_sampson(F, i) / point_threshold_sq_, 1.0);
+      total += std::min(sampson_squared(F, problem_.px1[i], problem_.px2[i]) /
+                            point_threshold_sq_, 1.0);
   }
   return total;
 }
@@ -68,7 +78,7 @@ int ModelScorer::pool_inliers(const RelativePose& pose, std::vector<char>* mask,
   const double threshold_sq = widen * widen * point_threshold_sq_;
   int count = 0;
   for (int i = 0; i < problem_.num_pool(); ++i) {
-    (*mask)[i] = squared_sampson(F, i) <= threshold_sq;
+    (*mask)[i] = sampson_squared(F, problem_.px1[i], problem_.px2[i]) <= threshold_sq;
     count += (*mask)[i];
   }
   return count;
@@ -92,7 +102,7 @@ int ModelScorer::line_support(const RelativePose& pose, std::vector<char>* mask)
   if (pose.t.squaredNorm() > 0.0) {
     const Eigen::Matrix3d F = fundamental(pose);
     for (size_t j = 0; j < problem_.junction_lines.size(); ++j) {
-      if (squared_sampson(F, problem_.junction_px1[j], problem_.junction_px2[j]) >
+      if (sampson_squared(F, problem_.junction_px1[j], problem_.junction_px2[j]) >
           point_threshold_sq_)
         continue;
       supported[problem_.junction_lines[j].first] = 1;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <opencv2/imgproc.hpp>
@@ -46,23 +47,30 @@ CornerStrength corner_strength(const cv::Mat& gray, const cv::Point2f& p, int wi
   if ((box & cv::Rect(0, 0, gray.cols, gray.rows)) != box) return {};
   // The 3x3 Sobel responses inside the box, written out: cv::Sobel on a box this small costs
   // ten times the arithmetic in setting up (a quarter of a 30 Hz room's front end), and gives
-  // these same values (integers times 1/8).
-  double xx = 0.0, xy = 0.0, yy = 0.0;
+  // these same values (integers times 1/8). The products are summed as integers: each is a
+  // multiple of 1/64 and every partial sum stays far below 2^53 / 64, so the double sums were
+  // exact and are the integer sums times 1/64, bit for bit.
+  int64_t sum_xx = 0, sum_xy = 0, sum_yy = 0;
   for (int y = box.y + 1; y < box.y + box.height - 1; ++y) {
     const uchar* above = gray.ptr<uchar>(y - 1);
     const uchar* row = gray.ptr<uchar>(y);
     const uchar* below = gray.ptr<uchar>(y + 1);
+    // A row's sums fit an int: each product is at most 1020^2, and window_px at most 401.
+    int row_xx = 0, row_xy = 0, row_yy = 0;
     for (int x = box.x + 1; x < box.x + box.width - 1; ++x) {
       const int gx = (above[x + 1] + 2 * row[x + 1] + below[x + 1]) -
                      (above[x - 1] + 2 * row[x - 1] + below[x - 1]);
       const int gy = (below[x - 1] + 2 * below[x] + below[x + 1]) -
                      (above[x - 1] + 2 * above[x] + above[x + 1]);
-      const double a = 0.125 * gx, b = 0.125 * gy;
-      xx += a * a;
-      xy += a * b;
-      yy += b * b;
+      row_xx += gx * gx;
+      row_xy += gx * gy;
+      row_yy += gy * gy;
     }
+    sum_xx += row_xx;
+    sum_xy += row_xy;
+    sum_yy += row_yy;
   }
+  const double xx = sum_xx / 64.0, xy = sum_xy / 64.0, yy = sum_yy / 64.0;
   const double n = (box.width - 2.0) * (box.height - 2.0);
   const double half_trace = 0.5 * (xx + yy), det = xx * yy - xy * xy;
   const double root = std::sqrt(std::max(0.0, half_trace * half_trace - det));

@@ -53,16 +53,26 @@ float normalise(const float* values, int count, float* out) {
   return root;
 }
 
-// The normalised correlation of a normalised template with `window` (count values).
-float correlation(const float* normalised, const float* window, int count) {
-  float sum = 0.0f, square = 0.0f, dot = 0.0f;
+// The normalised correlations of a normalised template (count values) with `window` at the
+// offsets 0 .. offsets - 1 (at most kMaxOffsets: track_segments_by_flow takes no search_px
+// beyond 40, 81 offsets). The offsets are the inner loop, so that it
+// vectorises; each offset's sums still run over k in order, as one offset's loop would.
+constexpr int kMaxOffsets = 96;
+void correlations(const float* normalised, const float* window, int count, int offsets,
+                  float* out) {
+  float sum[kMaxOffsets] = {}, square[kMaxOffsets] = {}, dot[kMaxOffsets] = {};
   for (int k = 0; k < count; ++k) {
-    sum += window[k];
-    square += window[k] * window[k];
-    dot += normalised[k] * window[k];
+    const float* shifted = window + k;
+    for (int d = 0; d < offsets; ++d) {
+      sum[d] += shifted[d];
+      square[d] += shifted[d] * shifted[d];
+      dot[d] += normalised[k] * shifted[d];
+    }
   }
-  const float variance = square - sum * sum / static_cast<float>(count);
-  return variance > 1e-3f ? dot / std::sqrt(variance) : 0.0f;
+  for (int d = 0; d < offsets; ++d) {
+    const float variance = square[d] - sum[d] * sum[d] / static_cast<float>(count);
+    out[d] = variance > 1e-3f ? dot[d] / std::sqrt(variance) : 0.0f;
+  }
 }
 
 // An image point in level `level`'s pixels (pyrDown maps x to (x + 0.5) / 2 - 0.5).
@@ -87,7 +97,7 @@ struct SampleSearch {
     profile(from[level], at_level(s, level), m, -h, width, tmpl);
     if (!(normalise(tmpl, width, normalised) > 0.0f)) return false;
     profile(to[level], at_level(q, level), n, -h - range, width + 2 * range, window);
-    for (int d = 0; d <= 2 * range; ++d) out[d] = correlation(normalised, window + d, width);
+    correlations(normalised, window, width, 2 * range + 1, out);
     return true;
   }
 
@@ -109,11 +119,10 @@ struct SampleSearch {
       // peak's).
       const int count = width + 2 * range + 2;
       profile(to[level], at_level(q, level), n, o - h - range - 1, count, window);
+      correlations(normalised, window + 1, width, 2 * range + 1, scores);
       int best = 0;
-      for (int d = 0; d <= 2 * range; ++d) {
-        scores[d] = correlation(normalised, window + 1 + d, width);
+      for (int d = 0; d <= 2 * range; ++d)
         if (scores[d] > scores[best]) best = d;
-      }
       // The best within the search: one at its end would lie beyond it.
       if (best == 0 || best == 2 * range) return false;
       o += static_cast<float>(best - range);
@@ -156,27 +165,31 @@ struct CoarseFit {
   double turn = 0.0;  // offset at the end minus that at the start (level pixels)
   int at(float where) const { return offset + static_cast<int>(std::lround(turn * (where - 0.5))); }
 };
-bool coarse_fit(const std::vector<std::vector<float>>& scores, const std::vector<float>& where,
-                int range, int max_turn, const SegmentFlowOptions& o, CoarseFit* fit) {
-  const int offsets = 2 * range + 1, usable = static_cast<int>(scores.size());
+// `scores` holds each sample's 2 range + 1 correlations in a row.
+bool coarse_fit(const std::vector<float>& scores, const std::vector<float>& where, int range,
+                int max_turn, const SegmentFlowOptions& o, CoarseFit* fit) {
+  const int offsets = 2 * range + 1, usable = static_cast<int>(where.size());
   // Per offset the best turn's mean correlation over the samples (half a pixel steps; a sample
   // the turn takes beyond the search counts as uncorrelated, lest turns gain by dropping the
   // samples that disagree).
   std::vector<float> total(offsets, -2.0f);
   std::vector<double> turn_of(offsets, 0.0);
-  std::vector<int> shift(usable);
+  std::vector<float> sum(offsets);
   for (int half_steps = -2 * max_turn; half_steps <= 2 * max_turn; ++half_steps) {
     CoarseFit turned;
     turned.turn = 0.5 * half_steps;
-    for (int i = 0; i < usable; ++i) shift[i] = turned.at(where[i]);
+    // Per offset d the sum over the samples i of scores[i][d + shift], in the order of i; the
+    // offsets are the inner loop, over those whose d + shift lies inside the search.
+    std::fill(sum.begin(), sum.end(), 0.0f);
+    for (int i = 0; i < usable; ++i) {
+      const int shift = turned.at(where[i]);
+      const float* own = scores.data() + static_cast<size_t>(i) * offsets;
+      for (int d = std::max(0, -shift); d < std::min(offsets, offsets - shift); ++d)
+        sum[d] += own[d + shift];
+    }
     for (int d = 0; d < offsets; ++d) {
-      float sum = 0.0f;
-      for (int i = 0; i < usable; ++i) {
-        const int k = d + shift[i];
-        if (k >= 0 && k < offsets) sum += scores[i][k];
-      }
-      if (sum / usable > total[d]) {
-        total[d] = sum / usable;
+      if (sum[d] / usable > total[d]) {
+        total[d] = sum[d] / usable;
         turn_of[d] = turned.turn;
       }
     }
@@ -235,9 +248,13 @@ SegmentFlow track_one(const std::vector<cv::Mat>& from, const std::vector<cv::Ma
   const int max_turn = std::min(
       range, static_cast<int>(std::ceil(predicted_length * scale *
                                         std::tan(o.coarse_turn_deg * M_PI / 180.0))));
+  const int offsets = 2 * range + 1;
   std::vector<Vec2> old_at, new_at;
-  std::vector<float> where;
-  std::vector<std::vector<float>> scores;
+  std::vector<float> where, scores;  // scores: a row of offsets per sample
+  old_at.reserve(samples);
+  new_at.reserve(samples);
+  where.reserve(samples);
+  scores.resize(static_cast<size_t>(samples) * offsets);
   for (int i = 0; i < samples; ++i) {
     const double t = static_cast<double>(i) / (samples - 1);
     const float ta = static_cast<float>(inset_a + t * (1.0 - 2.0 * inset_a));
@@ -245,21 +262,22 @@ SegmentFlow track_one(const std::vector<cv::Mat>& from, const std::vector<cv::Ma
     const Vec2 s = a1 + ta * (a2 - a1), q = b1 + tb * (b2 - b1);
     if (!inside(from[0], s) || !inside(to[0], q)) continue;
     ++flow.samples;
-    std::vector<float> sample_scores(2 * range + 1);
-    if (!search.scores(s, m, q, n, start, range, sample_scores.data())) continue;
+    float* sample_scores = scores.data() + old_at.size() * offsets;
+    if (!search.scores(s, m, q, n, start, range, sample_scores)) continue;
     old_at.push_back(s);
     new_at.push_back(q);
     where.push_back(static_cast<float>(t));
-    scores.push_back(std::move(sample_scores));
   }
+  scores.resize(old_at.size() * offsets);
   CoarseFit coarse;
-  if (static_cast<int>(scores.size()) < std::max(2, o.min_inliers) ||
+  if (static_cast<int>(old_at.size()) < std::max(2, o.min_inliers) ||
       !coarse_fit(scores, where, range, max_turn, o, &coarse))
     return flow;
   std::vector<Eigen::Vector2d> found;
+  found.reserve(old_at.size());
   for (size_t i = 0; i < old_at.size(); ++i) {
     // The sample's own peak within a pixel of the segment's fit (the turn is coarse).
-    const std::vector<float>& own = scores[i];
+    const float* own = scores.data() + i * offsets;
     int k = std::clamp(coarse.at(where[i]), 0, 2 * range);
     const int fitted = k;
     for (int j = std::max(0, fitted - 1); j <= std::min(2 * range, fitted + 1); ++j)
@@ -276,14 +294,14 @@ SegmentFlow track_one(const std::vector<cv::Mat>& from, const std::vector<cv::Ma
   Eigen::Vector2d centre, direction;
   std::vector<char> inlier(found.size(), 1);
   std::vector<Eigen::Vector2d> kept = found;
-  std::vector<double> residuals(found.size());
+  std::vector<double> residuals(found.size()), sorted;
   for (int round = 0; round < 3; ++round) {
     fit_line(kept, &centre, &direction);
     const Eigen::Vector2d normal(-direction.y(), direction.x());
     for (size_t k = 0; k < found.size(); ++k) residuals[k] = std::abs(normal.dot(found[k] - centre));
     // Within max_residual_px, and within three robust sigmas (the median's) of a line whose
     // samples agree better: a sample near a corner sees the other edge in its profile.
-    std::vector<double> sorted = residuals;
+    sorted.assign(residuals.begin(), residuals.end());
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     const double threshold =
         std::min(o.max_residual_px, std::max(o.min_residual_px, 3.0 * 1.4826 * sorted[sorted.size() / 2]));
@@ -320,6 +338,8 @@ SegmentFlow track_one(const std::vector<cv::Mat>& from, const std::vector<cv::Ma
     return true;
   };
   std::vector<double> steps, positions;
+  steps.reserve(kept.size());
+  positions.reserve(kept.size());
   for (const Eigen::Vector2d& p : kept) {
     double step = 0.0;
     if (step_across(p, &step)) steps.push_back(step);

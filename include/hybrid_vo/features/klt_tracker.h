@@ -127,7 +127,9 @@ void visit_fields(KltTrackerOptions& o, Visit&& visit) {
                   o.min_corner_isotropy, o.pyramid_levels, o.predicted_pyramid_levels);
   HYBRID_VO_FIELDS(fraction(), o.redetect_min_missing, o.refill_below);
   HYBRID_VO_FIELDS(positive_fraction(), o.quality_level);
-  HYBRID_VO_FIELDS(at_least(5), o.window_px);  // smaller windows lose the texture
+  // Smaller windows lose the texture; a larger one than 401 px tracks nothing a corner does
+  // (and the corner strength sums a row of its gradients in an int).
+  HYBRID_VO_FIELDS(between(5, 401), o.window_px);
   HYBRID_VO_FIELDS(any_value(), o.predict_motion, o.drop_leaving, o.redetect_alternate,
                   o.redetect_lost_cells,
                   o.strongest_first);

@@ -68,8 +68,10 @@ template <typename Visit>
 void visit_fields(SegmentFlowOptions& o, Visit&& visit) {
   HYBRID_VO_FIELDS(at_least(1), o.max_contrast_ratio);
   HYBRID_VO_FIELDS(positive(), o.sample_spacing_px, o.min_samples, o.max_samples,
-                  o.profile_half_px, o.search_px, o.min_inliers, o.max_residual_px,
-                  o.max_turn_deg);
+                  o.min_inliers, o.max_residual_px, o.max_turn_deg);
+  // As track_segments_by_flow takes them (it tracks nothing beyond).
+  HYBRID_VO_FIELDS(between(2, 30), o.profile_half_px);
+  HYBRID_VO_FIELDS(between(1, 40), o.search_px);
   HYBRID_VO_FIELDS(non_negative(), o.end_inset_px, o.levels, o.min_length_px, o.min_residual_px,
                   o.end_search_px);
   HYBRID_VO_FIELDS(fraction(), o.min_correlation, o.rival_margin, o.min_inlier_share);
