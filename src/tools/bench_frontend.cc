@@ -710,11 +710,6 @@ int run(int argc, char** argv) {
             je.push_back(sampson_error_px(cam, cam, est.pose, j.match.x1, j.match.x2));
             jt.push_back(sampson_error_px(cam, cam, truth_pose, j.match.x1, j.match.x2));
           }
-          const auto median = [](std::vector<double> v) {
-            if (v.empty()) return static_cast<double>(NAN);
-            std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-            return v[v.size() / 2];
-          };
           std::printf("   inliers' Sampson median (px) under the estimator's pose / the truth: "
                       "points %.3f / %.3f (%zu), junctions %.3f / %.3f (%zu)%s\n",
                       median(pe), median(pt), pe.size(), median(je), median(jt), je.size(),
