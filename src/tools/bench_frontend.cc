@@ -71,26 +71,25 @@ HalvesError halves_error(const PinholeCamera& camera, const TwoViewMatches& m,
       lines.push_back(m.lines[i]);
       line_vp.push_back(index[m.line_vp[i]]);
     }
+  // The scales the estimator measured; a scale it could not measure keeps the default.
   FinalRefinementOptions options;
   options.compute_covariance = false;
-  options.point_sigma_px = est.scales.point_px > 0.0 ? est.scales.point_px : 1.0 / 3.0;
-  options.line_vp_sigma_px = est.scales.line_vp_px > 0.0 ? est.scales.line_vp_px : 1.0 / 3.0;
-  options.vp_sigma_deg = est.scales.vp_deg > 0.0 ? est.scales.vp_deg : 2.0 / 3.0;
-  const auto error = [&](const std::vector<PointMatch>& p, bool with_segments, double sigma) {
+  if (est.scales.line_vp_px > 0.0) options.line_vp_sigma_px = est.scales.line_vp_px;
+  if (est.scales.vp_deg > 0.0) options.vp_sigma_deg = est.scales.vp_deg;
+  const auto error = [&](const std::vector<PointMatch>& p, double sigma_px, bool with_segments) {
+    if (p.size() < 5) return static_cast<double>(NAN);
     FinalRefinementOptions o = options;
-    if (sigma > 0.0) o.point_sigma_px = sigma;
-    const FinalRefinementResult r = refine_relative_pose_ceres(
-        camera, camera, p, with_segments ? vps : std::vector<VpMatch>(),
-        with_segments ? lines : std::vector<LineMatch>(), with_segments ? line_vp : std::vector<int>(),
-        est.pose, o);
+    if (sigma_px > 0.0) o.point_sigma_px = sigma_px;
+    const FinalRefinementResult r =
+        with_segments
+            ? refine_relative_pose_ceres(camera, camera, p, vps, lines, line_vp, est.pose, o)
+            : refine_relative_pose_ceres(camera, camera, p, {}, {}, {}, est.pose, o);
     return r.success ? rotation_error(r.pose.R, truth.R) * 180.0 / M_PI : NAN;
   };
   HalvesError e;
-  if (points.size() >= 5) e.points = error(points, false, 0.0);
-  if (junctions.size() >= 5) {
-    e.junctions = error(junctions, false, est.scales.junction_px);
-    e.rest = error(junctions, true, est.scales.junction_px);
-  }
+  e.points = error(points, est.scales.point_px, false);
+  e.junctions = error(junctions, est.scales.junction_px, false);
+  e.rest = error(junctions, est.scales.junction_px, true);
   return e;
 }
 
