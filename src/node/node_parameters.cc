@@ -129,6 +129,8 @@ const std::vector<Parameter>& parameters() {
       field<double>("min_parallax_px", NODE_FIELD(double, odometry.min_parallax_px)),
       field<bool>("rotation_only_pairs", NODE_FIELD(bool, odometry.rotation_only_pairs)),
       field<double>("keyframe_parallax_px", NODE_FIELD(double, odometry.keyframe_parallax_px)),
+      field<bool>("pair_with_previous_keyframe",
+                  NODE_FIELD(bool, odometry.pair_with_previous_keyframe)),
       field<double>("keyframe_overlap", NODE_FIELD(double, odometry.keyframe_overlap)),
       field<int>("keyframe_min_points", NODE_FIELD(int, odometry.keyframe_min_points)),
       field<bool>("track_lines", NODE_FIELD(bool, odometry.track_lines)),

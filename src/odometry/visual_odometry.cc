@@ -70,6 +70,7 @@ void VisualOdometry::restart() {
   line_tracker_.reset();
   line_flow_.reset();
   keyframe_ = Keyframe();
+  previous_keyframe_ = Keyframe();
   last_answer_stamp_ = -1e300;
   mono_speed_ = -1.0;
   window_.clear();
@@ -112,11 +113,13 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   const Pairing pairing = decide_keyframe(f);
   if (pairing == Pairing::kNewKeyframe) return keep_as_keyframe(f);
   if (pairing == Pairing::kSkip) return skip_frame(f);
-  prepare_pair(f);
-  f.baseline = pairing == Pairing::kEstimate;
-  if (!estimate(f)) {
-    if (f.baseline) return skip_frame(f);
-    f.rotation_only = true;  // without a baseline, the rotation may still be found
+  if (!estimate_against_previous_keyframe(f, pairing)) {
+    prepare_pair(f);
+    f.baseline = pairing == Pairing::kEstimate;
+    if (!estimate(f)) {
+      if (f.baseline) return skip_frame(f);
+      f.rotation_only = true;  // without a baseline, the rotation may still be found
+    }
   }
   if (f.rotation_only && !estimate_rotation(f)) return skip_frame(f);
   observe_scale(f);                        // both threads (the refinement)
@@ -124,7 +127,7 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   if (f.rotation_only || !f.baseline) measure_stereo_motion(f);
   orient(f);
   fit_scale(f);
-  if (keeps_keyframe(f)) {
+  if (f.against_previous || keeps_keyframe(f)) {
     refine_keyframe_depths(f);
     return answer_without_keyframe(f);
   }
@@ -228,11 +231,15 @@ VisualOdometryResult VisualOdometry::answer_without_keyframe(Frame& f) {
   // is off by tenths (a rate of degrees a second at 30 Hz, which on the white panels of TUM
   // misled the segments' tracking enough to end 14 degrees off instead of 4.5).
   const double dt = f.input.stamp - last_answer_stamp_;
-  if (f.rotation_only && dt > 0.0 && dt < 1.0)
+  if ((f.rotation_only || f.against_previous) && dt > 0.0 && dt < 1.0)
     orientation_.set_rate(nearest_rotation(r.R_wc.transpose() * last_answer_R_wc_), dt);
   last_answer_stamp_ = f.input.stamp;
   last_answer_R_wc_ = r.R_wc;
-  if (!f.rotation_only) {
+  if (f.against_previous) {
+    r.status = VoStatus::kOk;
+    r.message += "; paired with the keyframe before";
+    std::swap(keyframe_, previous_keyframe_);
+  } else if (!f.rotation_only) {
     r.status = VoStatus::kOk;
     r.message += "; no baseline: the keyframe stays";
   }

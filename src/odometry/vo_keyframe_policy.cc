@@ -51,6 +51,43 @@ bool VisualOdometry::keeps_keyframe(const Frame& f) const {
          seen >= options_.keyframe_overlap * std::max(0, keyframe_.paired_points);
 }
 
+bool VisualOdometry::estimate_against_previous_keyframe(Frame& f, Pairing pairing) {
+  if (pairing != Pairing::kEstimateKeepKeyframe || !previous_keyframe_.valid || f.stereo ||
+      !keeps_keyframe(f))
+    return false;
+  // What the frame knows of its pair with the keyframe, should the one before give none.
+  VisualOdometryResult kept = f.result;
+  const std::vector<int64_t> kept_ids = f.point_ids;
+  const double kept_parallax = f.parallax;
+  const RotationOnlyEstimate kept_rotation = f.rotation;
+  std::swap(keyframe_, previous_keyframe_);
+  VisualOdometryResult& r = f.result;
+  r.matches = TwoViewMatches();
+  f.point_ids.clear();
+  f.parallax = -1.0;
+  f.rotation = RotationOnlyEstimate();
+  match_points(f);
+  match_segments(f);
+  const bool enough = r.num_point_matches >= options_.min_point_matches ||
+                      r.num_line_matches >= options_.min_line_matches;
+  if (enough && f.parallax >= 0.0 && !low_parallax(f)) {
+    r.reference_stamp = keyframe_.stamp;
+    prepare_pair(f);
+    f.baseline = true;
+    // A pair the model selection takes for a rotation alone is no baseline either.
+    f.against_previous = estimate(f) && !f.rotation_only;
+    if (f.against_previous) return true;
+  }
+  std::swap(keyframe_, previous_keyframe_);
+  f.result = std::move(kept);
+  f.point_ids = kept_ids;
+  f.parallax = kept_parallax;
+  f.rotation = kept_rotation;
+  f.rotation_only = false;
+  f.vps_detected = false;
+  return false;
+}
+
 VisualOdometryResult VisualOdometry::keep_as_keyframe(Frame& f) {
   finish_stereo(f);
   finish_redetection(f);
@@ -79,6 +116,11 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
                                    std::vector<int64_t> pending) {
   const VisualOdometryInput& input = f.input;
   std::map<int64_t, InverseDepth> depths = keyframe_depths(f);
+  // The one before stays for the frames that see too little of this one's baseline.
+  if (f.result.became_keyframe && !f.stereo && options_.pair_with_previous_keyframe)
+    previous_keyframe_ = std::move(keyframe_);
+  else
+    previous_keyframe_ = Keyframe();
   keyframe_ = Keyframe();
   keyframe_.made_depths = depths;
   keyframe_.depths = std::move(depths);

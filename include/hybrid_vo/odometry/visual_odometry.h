@@ -67,6 +67,11 @@ struct VisualOdometryOptions {
   // remain to measure it. Frames before that are estimated against it and answered, each with
   // the baseline it has (or its rotation alone), so that the parallax builds up.
   double keyframe_parallax_px = 7.0;
+  // Mono: a frame with too little parallax for a baseline to a keyframe that stays (the frames
+  // just after it replaced the one before) is paired with the keyframe before instead where that
+  // one gives it a baseline (issue 58: a fifth to a half of the hand-held rooms' pairs had none).
+  // It is answered against that keyframe and becomes no keyframe itself.
+  bool pair_with_previous_keyframe = true;
   double keyframe_overlap = 0.3;
   int keyframe_min_points = 30;
   // Rotation-only pairs: where the points' own noise explains what the rotation leaves of their
@@ -164,7 +169,8 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   visit_fields(o.klt, prefixed("klt_", visit));
   visit_fields(o.estimator, prefixed("estimator_", visit));
   HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches);
-  HYBRID_VO_FIELDS(any_value(), o.rotation_only_pairs, o.model_selection);
+  HYBRID_VO_FIELDS(any_value(), o.rotation_only_pairs, o.model_selection,
+                  o.pair_with_previous_keyframe);
   HYBRID_VO_FIELDS(fraction(), o.keyframe_overlap);
   HYBRID_VO_FIELDS(non_negative(), o.keyframe_parallax_px, o.keyframe_min_points);
   visit("rotation_drift_floor_deg", o.orientation.drift_floor_deg, non_negative());
@@ -404,6 +410,10 @@ class VisualOdometry {
   // A frame leaves the keyframe in place while its parallax is short of keyframe_parallax_px (or
   // it has no baseline) and enough of the keyframe's points are seen.
   bool keeps_keyframe(const Frame& f) const;
+  // Mono, a frame that keeps the keyframe without a baseline: matched and estimated against the
+  // keyframe before (pair_with_previous_keyframe), which stands in as keyframe_ until the frame
+  // ends. False, and the frame as it was, where that gives no pair with a baseline.
+  bool estimate_against_previous_keyframe(Frame& f, Pairing pairing);
   VisualOdometryResult keep_as_keyframe(Frame& f);  // the frame's end: it becomes the keyframe
   VisualOdometryResult skip_frame(Frame& f);        // the frame's end: the keyframe stays
   // `points` with their stereo points matched so far; `pending` the ids still without (see
@@ -495,6 +505,7 @@ class VisualOdometry {
   // Kept across reset(): the offset belongs to the rig, not to the trajectory.
   DisparityOffsetFilter offset_filter_;
   Keyframe keyframe_;
+  Keyframe previous_keyframe_;  // the one keyframe_ replaced (mono, made by a pair), or invalid
   Eigen::Vector3d centre_ = Eigen::Vector3d::Zero();
   PoseCovarianceChain pose_covariance_;
   double last_stamp_ = -1e300;
