@@ -84,6 +84,8 @@ std::vector<Case> every_parameter() {
       {"keyframe_overlap", 0.5, [](P p) { return p.odometry.keyframe_overlap == 0.5; }},
       {"keyframe_parallax_px", 9.0, [](P p) { return p.odometry.keyframe_parallax_px == 9.0; }},
       {"keyframe_min_points", 50, [](P p) { return p.odometry.keyframe_min_points == 50; }},
+      {"pair_with_previous_keyframe", false,
+       [](P p) { return !p.odometry.pair_with_previous_keyframe; }},
       {"track_lines", false, [](P p) { return !p.odometry.track_lines; }},
       {"line_flow", true, [](P p) { return p.odometry.line_flow; }},
       {"concurrent_frontend", false, [](P p) { return !p.odometry.concurrent; }},

@@ -15,6 +15,11 @@
 
 namespace hybrid_vo {
 
+// How much less sure than mono_depth_max_direction_sigma a direction may be for the depths of a
+// keyframe that knew none (the hand-held room's first pair with a baseline: 5.3 degrees), for a
+// length fitted to depths, and for two keyframes to be a baseline apart.
+constexpr double kLooseDirectionFactor = 3.0;
+
 // The largest standard deviation of a pair's translation direction (radians; infinite without
 // one).
 inline double translation_direction_sigma(const VisualOdometryResult& r) {

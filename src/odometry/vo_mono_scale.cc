@@ -17,10 +17,6 @@
 namespace hybrid_vo {
 namespace {
 
-// How much less sure than mono_depth_max_direction_sigma a direction may be for the depths of a
-// keyframe that knew none (the hand-held room's first pair with a baseline: 5.3 degrees), and for
-// a length fitted to depths.
-constexpr double kLooseDirectionFactor = 3.0;
 constexpr int kLooseMinPoints = 100;
 
 }  // namespace
