@@ -265,7 +265,7 @@ TEST(Answers, ASlowHandheldCameraPairsWithTheKeyframeBefore) {
   VisualOdometryOptions with = sequential();
   with.keyframe_parallax_px = 4.0;
   VisualOdometryOptions without = with;
-  without.pair_with_previous_keyframe = false;
+  without.previous_keyframe_parallax_px = 0.0;
   const OdometryRun run = run_rendered(Motion::kHandheld, frames, rate, false, 1, with);
   const OdometryRun old = run_rendered(Motion::kHandheld, frames, rate, false, 1, without);
   auto baselines = [](const OdometryRun& r) {

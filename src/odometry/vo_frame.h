@@ -72,7 +72,7 @@ struct VisualOdometry::Frame {
   RotationOnlyEstimate rotation;
   bool rotation_only = false;  // the pair is answered with its rotation alone
   bool baseline = true;        // its parallax after the rotation makes a baseline
-  // Paired with the keyframe before (pair_with_previous_keyframe), which is keyframe_ until the
+  // Paired with the keyframe before (previous_keyframe_parallax_px), which is keyframe_ until the
   // frame is answered.
   bool against_previous = false;
   // Stereo, without a baseline or with a rotation alone: the motion from the stereo points.

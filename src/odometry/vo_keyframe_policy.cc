@@ -6,7 +6,7 @@
 // are answered with their full pose against it, those that moved too little off their rotation
 // for a baseline (min_parallax_px), or whose points' noise explains what the rotation leaves
 // (model selection), with their rotation alone; in mono, those with the keyframe before where it
-// gives them a baseline (pair_with_previous_keyframe). Without rotation-only pairs such frames
+// gives them a baseline (previous_keyframe_parallax_px). Without rotation-only pairs such frames
 // are left out, as any frame whose pose is not found. Also what a keyframe keeps.
 #include <string>
 
@@ -53,8 +53,11 @@ bool VisualOdometry::keeps_keyframe(const Frame& f) const {
 }
 
 bool VisualOdometry::estimate_against_previous_keyframe(Frame& f, Pairing pairing) {
-  if (pairing != Pairing::kEstimateKeepKeyframe || !previous_keyframe_.valid || f.stereo ||
-      !keeps_keyframe(f))
+  const bool short_parallax =
+      pairing == Pairing::kEstimateKeepKeyframe ||
+      (pairing == Pairing::kEstimate && f.parallax >= 0.0 &&
+       f.parallax < options_.previous_keyframe_parallax_px);
+  if (!short_parallax || !previous_keyframe_.valid || f.stereo || !keeps_keyframe(f))
     return false;
   // What the frame knows of its pair with the keyframe, should the one before give none.
   VisualOdometryResult kept = f.result;
@@ -71,7 +74,7 @@ bool VisualOdometry::estimate_against_previous_keyframe(Frame& f, Pairing pairin
   match_segments(f);
   const bool enough = r.num_point_matches >= options_.min_point_matches ||
                       r.num_line_matches >= options_.min_line_matches;
-  if (enough && f.parallax >= 0.0 && !low_parallax(f)) {
+  if (enough && f.parallax > kept_parallax && !low_parallax(f)) {
     r.reference_stamp = keyframe_.stamp;
     prepare_pair(f);
     f.baseline = true;
@@ -125,7 +128,7 @@ void VisualOdometry::make_keyframe(Frame& f, std::map<int64_t, Eigen::Vector2d> 
   const double sure = kLooseDirectionFactor * options_.mono_depth_max_direction_sigma;
   const bool translated = r.became_keyframe && r.baseline && !f.rotation_only &&
                           r.motion_covariance_valid && translation_direction_sigma(r) <= sure;
-  if (translated && !f.stereo && options_.pair_with_previous_keyframe)
+  if (translated && !f.stereo && options_.previous_keyframe_parallax_px > 0.0)
     previous_keyframe_ = std::move(keyframe_);
   else
     previous_keyframe_ = Keyframe();

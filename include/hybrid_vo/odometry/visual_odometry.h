@@ -67,11 +67,12 @@ struct VisualOdometryOptions {
   // remain to measure it. Frames before that are estimated against it and answered, each with
   // the baseline it has (or its rotation alone), so that the parallax builds up.
   double keyframe_parallax_px = 7.0;
-  // Mono: a frame with too little parallax for a baseline to a keyframe that stays (the frames
-  // just after it replaced the one before) is paired with the keyframe before instead where that
-  // one gives it a baseline (issue 58: a fifth to a half of the hand-held rooms' pairs had none).
-  // It is answered against that keyframe and becomes no keyframe itself.
-  bool pair_with_previous_keyframe = true;
+  // Mono: a frame with less parallax than this to a keyframe that stays (the frames just after
+  // it replaced the one before) is paired with the keyframe before instead where that one gives
+  // it more, and a baseline (issue 58: a fifth to a half of the hand-held rooms' pairs had none,
+  // and those with 2-3 px were 10-25 degrees off in direction). It is answered against that
+  // keyframe and becomes no keyframe itself. 0: never.
+  double previous_keyframe_parallax_px = 3.0;
   double keyframe_overlap = 0.3;
   int keyframe_min_points = 30;
   // Rotation-only pairs: where the points' own noise explains what the rotation leaves of their
@@ -169,10 +170,10 @@ void visit_fields(VisualOdometryOptions& o, Visit&& visit) {
   visit_fields(o.klt, prefixed("klt_", visit));
   visit_fields(o.estimator, prefixed("estimator_", visit));
   HYBRID_VO_FIELDS(non_negative(), o.min_parallax_px, o.min_point_matches, o.min_line_matches);
-  HYBRID_VO_FIELDS(any_value(), o.rotation_only_pairs, o.model_selection,
-                  o.pair_with_previous_keyframe);
+  HYBRID_VO_FIELDS(any_value(), o.rotation_only_pairs, o.model_selection);
   HYBRID_VO_FIELDS(fraction(), o.keyframe_overlap);
-  HYBRID_VO_FIELDS(non_negative(), o.keyframe_parallax_px, o.keyframe_min_points);
+  HYBRID_VO_FIELDS(non_negative(), o.keyframe_parallax_px, o.keyframe_min_points,
+                  o.previous_keyframe_parallax_px);
   visit("rotation_drift_floor_deg", o.orientation.drift_floor_deg, non_negative());
   visit("rotation_calibration_sigma", o.rotation_calibration_sigma, non_negative());
   visit("full_pair_turn_fraction", o.full_pair_turn_fraction, non_negative());
@@ -410,9 +411,9 @@ class VisualOdometry {
   // A frame leaves the keyframe in place while its parallax is short of keyframe_parallax_px (or
   // it has no baseline) and enough of the keyframe's points are seen.
   bool keeps_keyframe(const Frame& f) const;
-  // Mono, a frame that keeps the keyframe without a baseline: matched and estimated against the
-  // keyframe before (pair_with_previous_keyframe), which stands in as keyframe_ until the frame
-  // ends. False, and the frame as it was, where that gives no pair with a baseline.
+  // Mono, a frame that keeps the keyframe with less than previous_keyframe_parallax_px: matched
+  // and estimated against the keyframe before, which stands in as keyframe_ until the frame ends.
+  // False, and the frame as it was, where that gives no pair with more parallax and a baseline.
   bool estimate_against_previous_keyframe(Frame& f, Pairing pairing);
   VisualOdometryResult keep_as_keyframe(Frame& f);  // the frame's end: it becomes the keyframe
   VisualOdometryResult skip_frame(Frame& f);        // the frame's end: the keyframe stays
