@@ -282,6 +282,7 @@ TEST(Answers, ASlowHandheldCameraPairsWithTheKeyframeBefore) {
     if (reference < last_keyframe) {
       ++before;
       EXPECT_TRUE(r.baseline) << i;
+      EXPECT_TRUE(r.paired_with_keyframe_before) << i;
       EXPECT_FALSE(r.became_keyframe) << i;
       // The truth's motion from that keyframe's camera to this one, in the keyframe's.
       const Eigen::Vector3d t_true =
@@ -291,6 +292,8 @@ TEST(Answers, ASlowHandheldCameraPairsWithTheKeyframeBefore) {
       direction_errors.push_back(
           std::acos(std::clamp(t.normalized().dot(t_true.normalized()), -1.0, 1.0)) * kDeg);
     }
+    else
+      EXPECT_FALSE(r.paired_with_keyframe_before) << i;
     if (r.became_keyframe) last_keyframe = i;
     EXPECT_LT(orientation_error_deg(run, i), 0.5) << i;
   }

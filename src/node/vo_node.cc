@@ -266,6 +266,7 @@ void VoNode::record_result(const Frame& frame, const VisualOdometryResult& resul
       else if (std::isfinite(est.vp_prior_chi2[k])) ++vp_priors_rejected_;
     }
     rotation_only_frames_ += result.status == VoStatus::kRotationOnly;
+    keyframe_before_frames_ += result.paired_with_keyframe_before;
     if (result.status == VoStatus::kOk || result.status == VoStatus::kRotationOnly) {
       blank_wall_frames_ += result.orientation.blank_wall;
       pairs_overruled_ += result.orientation.source == OrientationSource::kPairRejected;

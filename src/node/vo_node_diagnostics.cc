@@ -159,6 +159,7 @@ void VoNode::add_vp_tracks(diagnostic_updater::DiagnosticStatusWrapper& status) 
   status.add("pairs overruled by the map", pairs_overruled_);
   status.add("blank-wall frames", blank_wall_frames_);
   status.add("rotation-only frames (no translation seen)", rotation_only_frames_);
+  status.add("frames paired with the keyframe before", keyframe_before_frames_);
   status.add("VP priors used", vp_priors_used_);
   status.add("VP priors rejected by the gate", vp_priors_rejected_);
 }

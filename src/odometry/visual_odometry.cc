@@ -237,6 +237,7 @@ VisualOdometryResult VisualOdometry::answer_without_keyframe(Frame& f) {
   last_answer_R_wc_ = r.R_wc;
   if (f.against_previous) {
     r.status = VoStatus::kOk;
+    r.paired_with_keyframe_before = true;
     r.message += "; paired with the keyframe before";
     std::swap(keyframe_, previous_keyframe_);
   } else if (!f.rotation_only) {

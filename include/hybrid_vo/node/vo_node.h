@@ -234,6 +234,7 @@ class VoNode {
   DirectionMapStats map_stats_;
   int vp_priors_used_ = 0, vp_priors_rejected_ = 0, blank_wall_frames_ = 0, pairs_overruled_ = 0;
   int rotation_only_frames_ = 0;
+  int keyframe_before_frames_ = 0;  // mono frames paired with the keyframe before the current
 
   InjectedLeak injected_leak_;  // the soak's own test only (scripts/soak --leak)
 };

@@ -230,6 +230,9 @@ struct VisualOdometryResult {
   VoStatus status = VoStatus::kInvalidInput;
   std::string message;
   double reference_stamp = 0.0;  // the keyframe the frame was paired with
+  // Mono: that keyframe is the one before the current (previous_keyframe_parallax_px): this
+  // frame had too little parallax to the current one.
+  bool paired_with_keyframe_before = false;
   TwoViewEstimate estimate;
   RelativePose motion;           // X_cur = R X_ref + t, t scaled (metric when scale_known)
   bool scale_known = false;
