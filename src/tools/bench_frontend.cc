@@ -528,7 +528,7 @@ int run(int argc, char** argv) {
   // Every estimated pair's point matches and junctions: their Sampson error under the truth.
   std::vector<double> point_truth_px, junction_truth_px;
   // Keyframes, and the answered frames a second after the first and those of them with a baseline.
-  int keyframes = 1, late_answers = 0, late_baselines = 0, late_translations = 0;
+  int keyframes = 1, late_answers = 0, late_baselines = 0, late_translations = 0, late_before = 0;
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
   evaluation::DirectionSightings vp_sightings;  // the VP observations' NEES (2 dof)
   double farthest = 0.0;             // of the position from the first frame's
@@ -840,6 +840,7 @@ int run(int argc, char** argv) {
     if (answered(r.status) && input.stamp - stamps[0] >= 1.0) {
       ++late_answers;
       late_baselines += r.baseline;
+      late_before += r.paired_with_keyframe_before;
       // Its translation measured: by a baseline, or without one by the keyframe's depths (mono)
       // or stereo points.
       late_translations += r.baseline || r.translation_from_depths ||
@@ -881,11 +882,12 @@ int run(int argc, char** argv) {
               frames > 1 ? 100.0 * answered_frames / (frames - 1) : 0.0, rotation_only, farthest,
               stereo ? "m" : "per-pair units");
   std::printf("# keyframes: %d of %d frames; after the first second %d of %d answered frames have "
-              "a baseline (%.1f %%), %d a measured translation (%.1f %%: with a baseline, or "
-              "without one from the keyframe's depths or stereo points)\n",
+              "a baseline (%.1f %%; %d of them with the keyframe before), %d a measured "
+              "translation (%.1f %%: with a baseline, or without one from the keyframe's depths "
+              "or stereo points)\n",
               keyframes, frames, late_baselines, late_answers,
-              late_answers > 0 ? 100.0 * late_baselines / late_answers : 0.0, late_translations,
-              late_answers > 0 ? 100.0 * late_translations / late_answers : 0.0);
+              late_answers > 0 ? 100.0 * late_baselines / late_answers : 0.0, late_before,
+              late_translations, late_answers > 0 ? 100.0 * late_translations / late_answers : 0.0);
   {
     const KltTrackStats& t = vo.point_track_stats();
     const double per_frame = t.frames > 0 ? 1.0 / t.frames : 0.0;
