@@ -127,7 +127,8 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   if (f.rotation_only || !f.baseline) measure_stereo_motion(f);
   orient(f);
   fit_scale(f);
-  if (f.against_previous || keeps_keyframe(f)) {
+  // Paired with the keyframe before, which is keyframe_ until the frame is answered.
+  if (f.result.paired_with_keyframe_before || keeps_keyframe(f)) {
     refine_keyframe_depths(f);
     return answer_without_keyframe(f);
   }
@@ -231,13 +232,12 @@ VisualOdometryResult VisualOdometry::answer_without_keyframe(Frame& f) {
   // is off by tenths (a rate of degrees a second at 30 Hz, which on the white panels of TUM
   // misled the segments' tracking enough to end 14 degrees off instead of 4.5).
   const double dt = f.input.stamp - last_answer_stamp_;
-  if ((f.rotation_only || f.against_previous) && dt > 0.0 && dt < 1.0)
+  if ((f.rotation_only || r.paired_with_keyframe_before) && dt > 0.0 && dt < 1.0)
     orientation_.set_rate(nearest_rotation(r.R_wc.transpose() * last_answer_R_wc_), dt);
   last_answer_stamp_ = f.input.stamp;
   last_answer_R_wc_ = r.R_wc;
-  if (f.against_previous) {
+  if (r.paired_with_keyframe_before) {
     r.status = VoStatus::kOk;
-    r.paired_with_keyframe_before = true;
     r.message += "; paired with the keyframe before";
     std::swap(keyframe_, previous_keyframe_);
   } else if (!f.rotation_only) {

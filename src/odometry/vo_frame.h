@@ -72,9 +72,6 @@ struct VisualOdometry::Frame {
   RotationOnlyEstimate rotation;
   bool rotation_only = false;  // the pair is answered with its rotation alone
   bool baseline = true;        // its parallax after the rotation makes a baseline
-  // Paired with the keyframe before (previous_keyframe_parallax_px), which is keyframe_ until the
-  // frame is answered.
-  bool against_previous = false;
   // Stereo, without a baseline or with a rotation alone: the motion from the stereo points.
   StereoMotionEstimate stereo_motion;
 

@@ -79,8 +79,8 @@ bool VisualOdometry::estimate_against_previous_keyframe(Frame& f, Pairing pairin
     prepare_pair(f);
     f.baseline = true;
     // A pair the model selection takes for a rotation alone is no baseline either.
-    f.against_previous = estimate(f) && !f.rotation_only;
-    if (f.against_previous) return true;
+    r.paired_with_keyframe_before = estimate(f) && !f.rotation_only;
+    if (r.paired_with_keyframe_before) return true;
   }
   std::swap(keyframe_, previous_keyframe_);
   f.result = std::move(kept);

@@ -71,7 +71,8 @@ struct VisualOdometryOptions {
   // it replaced the one before) is paired with the keyframe before instead where that one gives
   // it more, and a baseline (issue 58: a fifth to a half of the hand-held rooms' pairs had none,
   // and those with 2-3 px were 10-25 degrees off in direction). It is answered against that
-  // keyframe and becomes no keyframe itself. 0: never.
+  // keyframe and becomes no keyframe itself. Frames below min_parallax_px try it whatever this
+  // is above 0; 0: never.
   double previous_keyframe_parallax_px = 3.0;
   double keyframe_overlap = 0.3;
   int keyframe_min_points = 30;
