@@ -388,8 +388,9 @@ TEST(FeatureTopics, EstimatorUsesTheGivenFeatures) {
   for (const auto& [stamp, m] : h.motions_) {
     if (m.status != MotionEstimate::STATUS_OK) continue;
     ++ok;
+    // The images are black: inliers can only come from the published features. (No timing
+    // check here: frontend_ms varies with the machine; benchmarks own the targets.)
     EXPECT_GT(m.point_inliers, 10u);
-    EXPECT_LT(m.frontend_ms, 20.0);  // nothing was detected in the black images
     with_lines += m.line_inliers > 5;
     const int frame = static_cast<int>(std::lround((stamp.toSec() - 1.0) * options.rate));
     const int ref = static_cast<int>(std::lround((m.reference_stamp.toSec() - 1.0) * options.rate));
