@@ -97,6 +97,8 @@ std::vector<Case> every_parameter() {
       {"klt_redetect_alternate", true, [](P p) { return p.odometry.klt.redetect_alternate; }},
       {"klt_redetect_lost_cells", true,
        [](P p) { return p.odometry.klt.redetect_lost_cells; }},
+      {"klt_correct_vignetting", false,
+       [](P p) { return !p.odometry.klt.correct_vignetting; }},
       {"klt_min_corner_gradient", 1.5,
        [](P p) { return p.odometry.klt.min_corner_gradient == 1.5; }},
       {"klt_min_corner_isotropy", 0.3,

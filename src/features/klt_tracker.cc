@@ -91,6 +91,7 @@ void KltTracker::set_work(int max_features, double redetect_min_missing, bool re
 
 void KltTracker::reset() {
   previous_.clear();
+  previous_raw_.release();
   size_ = cv::Size();
   points_.clear();
   motion_.clear();
@@ -217,7 +218,9 @@ std::vector<cv::Mat> KltTracker::build_pyramid(const GrayImage& image) const {
   std::vector<cv::Mat> pyramid;
   if (image.empty()) return pyramid;
   const cv::Size window(options_.window_px, options_.window_px);
-  cv::buildOpticalFlowPyramid(image.mat(), pyramid, window, options_.pyramid_levels, true);
+  pending_raw_ = image.mat();
+  cv::buildOpticalFlowPyramid(flat_field(image.mat(), gain_map_), pyramid, window,
+                              options_.pyramid_levels, true);
   return pyramid;
 }
 
@@ -234,7 +237,15 @@ std::vector<PointMatch> KltTracker::track_pyramid(std::vector<cv::Mat> pyramid,
   if (ids) ids->clear();
   if (pyramid.empty()) return matches;
   const cv::Size size = pyramid[0].size();
-  if (!previous_.empty() && size_ != size) reset();
+  if (!previous_.empty() && size_ != size) {
+    reset();
+    vignetting_.reset();
+    gain_map_.release();
+  }
+  // The image as it came, for its brightness and the corners; the pyramid's level 0 without
+  // a correction.
+  cv::Mat raw = pending_raw_.size() == size ? pending_raw_ : pyramid[0];
+  pending_raw_.release();
 
   if (!previous_.empty() && !points_.empty()) {
     const int n = static_cast<int>(points_.size());
@@ -284,6 +295,7 @@ std::vector<PointMatch> KltTracker::track_pyramid(std::vector<cv::Mat> pyramid,
       kept_ids.push_back(ids_[i]);
       kept_age.push_back(age + 1);
     }
+    if (options_.correct_vignetting) update_vignetting(raw, matches);
     points_ = std::move(kept);
     motion_ = std::move(kept_motion);
     ids_ = std::move(kept_ids);
@@ -294,7 +306,37 @@ std::vector<PointMatch> KltTracker::track_pyramid(std::vector<cv::Mat> pyramid,
   stamp_ = stamp;
   size_ = size;
   previous_ = std::move(pyramid);
+  // A copy: the caller may reuse its image's buffer for the next frame.
+  if (options_.correct_vignetting) previous_raw_ = raw.clone();
+  else previous_raw_.release();
   return matches;
+}
+
+void KltTracker::update_vignetting(const cv::Mat& raw, const std::vector<PointMatch>& matches) {
+  if (previous_raw_.empty() || previous_raw_.size() != raw.size()) return;
+  std::vector<cv::Point2f> from, to;
+  from.reserve(matches.size());
+  to.reserve(matches.size());
+  for (const PointMatch& m : matches) {
+    from.emplace_back(static_cast<float>(m.x1.x()), static_cast<float>(m.x1.y()));
+    to.emplace_back(static_cast<float>(m.x2.x()), static_cast<float>(m.x2.y()));
+  }
+  vignetting_.add_pair(previous_raw_, raw, from, to);
+  if (!vignetting_.active()) {
+    gain_map_.release();
+    return;
+  }
+  // A new map (never written in place: a stereo job may still read the last one) only when the
+  // corners' gain moved by half a percent.
+  if (gain_map_.size() != raw.size() ||
+      std::abs(vignetting_.corner_gain() - map_corner_) > 0.005) {
+    gain_map_ = vignetting_gain_map(raw.size(), vignetting_.a(), vignetting_.b());
+    map_corner_ = vignetting_.corner_gain();
+  }
+}
+
+const cv::Mat& KltTracker::detection_image() const {
+  return previous_raw_.empty() ? previous_[0] : previous_raw_;
 }
 
 void KltTracker::detect_new(const ParallelFor& parallel) {
@@ -310,7 +352,7 @@ KltDetection KltTracker::plan_detection() const {
     return d;
   }
   // Level 0 of the pyramid is the image (inside the border the pyramid adds).
-  const cv::Mat& gray = previous_[0];
+  const cv::Mat& gray = detection_image();
   // Re-detection by buckets keeps features spread over the image (a cluster of tracks on one
   // textured object makes a poorly conditioned relative pose). With fewer features than cells
   // the grid gets coarser, so that every cell has a quota of at least one and max_features stays
@@ -362,7 +404,7 @@ KltDetection KltTracker::plan_detection() const {
 
 void KltTracker::detect_cell(KltDetection* d, int c) const {
   if (previous_.empty() || c < 0 || c >= d->cells() || d->wanted[c] <= 0) return;
-  const cv::Mat& gray = previous_[0];
+  const cv::Mat& gray = detection_image();
   const int cx = c % d->cols, cy = c / d->cols;
   const cv::Rect cell = cv::Rect(cx * d->cell_w, cy * d->cell_h, d->cell_w, d->cell_h) &
                         cv::Rect(0, 0, gray.cols, gray.rows);

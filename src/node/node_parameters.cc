@@ -144,6 +144,8 @@ const std::vector<Parameter>& parameters() {
       field<bool>("klt_redetect_alternate", NODE_FIELD(bool, odometry.klt.redetect_alternate)),
       field<bool>("klt_redetect_lost_cells",
                   NODE_FIELD(bool, odometry.klt.redetect_lost_cells)),
+      field<bool>("klt_correct_vignetting",
+                  NODE_FIELD(bool, odometry.klt.correct_vignetting)),
       field<double>("klt_min_corner_gradient",
                     NODE_FIELD(double, odometry.klt.min_corner_gradient)),
       field<double>("klt_min_corner_isotropy",

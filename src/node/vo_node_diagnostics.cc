@@ -94,6 +94,8 @@ void VoNode::add_tracking(diagnostic_updater::DiagnosticStatusWrapper& status) c
   status.add("tracking state", to_string(r.status));
   status.add("point matches", r.num_point_matches);
   status.add("point inliers", est.num_point_inliers);
+  status.add("vignetting at the corners (measured by the tracks)", r.vignetting_corner_gain);
+  status.add("vignetting taken out for tracking", r.vignetting_corrected ? "yes" : "no");
   status.add("line matches", r.num_line_matches);
   status.add("line inliers", est.num_line_inliers);
   status.add("VP inliers", est.num_vp_inliers);

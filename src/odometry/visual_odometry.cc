@@ -96,7 +96,10 @@ VisualOdometryResult VisualOdometry::run_frame(const VisualOdometryInput& input)
   // of the KLT searches, of the stereo searches, of the re-detection and of the scale's
   // refinement. This thread tracks the points meanwhile, then estimates while the second one
   // matches the stereo points, and takes what is left of a shared stage when it needs its results.
-  if (f.stereo) f.pyramids_job = worker_->submit([this, &f] { build_stereo_pyramids(f); });
+  if (f.stereo) {
+    if (f.klt_pyramid) f.flat_field_gain = klt_.flat_field_gain();  // before tracking updates it
+    f.pyramids_job = worker_->submit([this, &f] { build_stereo_pyramids(f); });
+  }
   build_pyramid(f);                        // before the segments, which may follow its flow
   const bool lines = options_.use_lines && !input.external.has_lines;
   const bool flow = lines && options_.track_lines && options_.line_flow;

@@ -48,6 +48,8 @@ struct VisualOdometry::Frame {
   bool tracking = false;     // points are KLT tracks (not external, not descriptors)
   bool stereo = false;       // a right image with a baseline: metric scale
   bool klt_pyramid = false;  // the KLT tracker's pyramid of the image serves the stereo matching
+  // Its vignetting correction (KltTracker::flat_field_gain), which the right image then takes too.
+  cv::Mat flat_field_gain;
   std::vector<cv::Mat> pyramid;  // the image's (build_pyramid), or empty
   // How the segments move from the last frame as the camera turns at its last rate.
   Eigen::Matrix3d segment_motion = Eigen::Matrix3d::Identity();

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <limits>
 
+#include "hybrid_vo/features/vignetting.h"
 #include "vo_frame.h"
 
 namespace hybrid_vo {
@@ -21,7 +22,8 @@ std::map<int64_t, Eigen::Vector3d> VisualOdometry::StereoFeatures::points() cons
 }
 
 void VisualOdometry::build_stereo_pyramids(Frame& f) const {
-  f.pair.right = stereo_pyramid(GrayImage(f.input.right_image).mat(), options_.stereo);
+  f.pair.right = stereo_pyramid(flat_field(GrayImage(f.input.right_image).mat(), f.flat_field_gain),
+                                options_.stereo);
   if (!f.klt_pyramid) f.pair.left = stereo_pyramid(f.gray.mat(), options_.stereo);
 }
 

@@ -47,6 +47,7 @@ void VisualOdometry::build_pyramid(Frame& f) const {
   const bool flow = options_.use_lines && options_.track_lines && options_.line_flow &&
                     !f.input.external.has_lines;
   if (f.tracking) {
+    f.result.vignetting_corrected = !klt_.flat_field_gain().empty();
     f.pyramid = klt_.build_pyramid(f.gray);
   } else if (flow) {
     const int window = options_.klt.window_px;
@@ -107,6 +108,7 @@ void VisualOdometry::track_points(Frame& f) {
   } else if (f.tracking) {
     // The searches on both threads, the second once it has detected the segments.
     f.point_motion = klt_.track_pyramid(f.pyramid, nullptr, f.input.stamp, worker_->parallel());
+    f.result.vignetting_corner_gain = klt_.vignetting().corner_gain();
     f.points = klt_points();
     if (f.klt_pyramid) f.pair.left = klt_.pyramid();
   } else {

@@ -529,6 +529,7 @@ int run(int argc, char** argv) {
   std::vector<double> point_truth_px, junction_truth_px;
   // Keyframes, and the answered frames a second after the first and those of them with a baseline.
   int keyframes = 1, late_answers = 0, late_baselines = 0, late_translations = 0, late_before = 0;
+  int vignetting_frames = 0;  // tracked on the image less its vignetting
   std::vector<double> pair_t_nees;   // stereo: the metric translation's NEES (3 dof)
   evaluation::DirectionSightings vp_sightings;  // the VP observations' NEES (2 dof)
   double farthest = 0.0;             // of the position from the first frame's
@@ -837,6 +838,7 @@ int run(int argc, char** argv) {
     stereo_ms.push_back(r.stages.stereo_ms);
     answered_frames += answered(r.status);
     keyframes += r.became_keyframe;
+    vignetting_frames += r.vignetting_corrected;
     if (answered(r.status) && input.stamp - stamps[0] >= 1.0) {
       ++late_answers;
       late_baselines += r.baseline;
@@ -896,6 +898,10 @@ int run(int argc, char** argv) {
                 t.searched * per_frame, t.detected * per_frame,
                 t.lost > 0 ? 100.0 * t.lost_at_first / t.lost : 0.0, t.median_lifetime(),
                 t.lost > 0 ? static_cast<double>(t.lifetime_sum) / t.lost : 0.0);
+    const VignettingEstimator& v = vo.point_track_vignetting();
+    std::printf("# vignetting: the corners at %.3f of the centre's brightness (%d pairs, "
+                "information %.1f), taken out for tracking on %d of %d frames\n",
+                v.corner_gain(), v.pairs(), v.information(), vignetting_frames, frames);
   }
   // Starting to move (stereo, with a truth in the first camera's frame): where the camera went
   // from its start, once it is 5 cm or more away, against where it truly went, and its length.

@@ -234,6 +234,10 @@ struct VisualOdometryResult {
   // Mono: that keyframe is the one before the current (previous_keyframe_parallax_px): this
   // frame had too little parallax to the current one.
   bool paired_with_keyframe_before = false;
+  // The KLT tracks' vignetting (KltTrackerOptions::correct_vignetting): V at the image's corners
+  // as measured so far, and whether this frame was tracked on the image with it taken out.
+  double vignetting_corner_gain = 1.0;
+  bool vignetting_corrected = false;
   TwoViewEstimate estimate;
   RelativePose motion;           // X_cur = R X_ref + t, t scaled (metric when scale_known)
   bool scale_known = false;
@@ -309,6 +313,7 @@ class VisualOdometry {
   const DirectionMap& direction_map() const { return orientation_.direction_map(); }
   // The KLT tracks' cost and lifetimes so far (KLT tracking only).
   const KltTrackStats& point_track_stats() const { return klt_.stats(); }
+  const VignettingEstimator& point_track_vignetting() const { return klt_.vignetting(); }
   const VisualOdometryOptions& options() const { return options_; }
 
  private:
