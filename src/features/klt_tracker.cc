@@ -218,7 +218,6 @@ std::vector<cv::Mat> KltTracker::build_pyramid(const GrayImage& image) const {
   std::vector<cv::Mat> pyramid;
   if (image.empty()) return pyramid;
   const cv::Size window(options_.window_px, options_.window_px);
-  pending_raw_ = image.mat();
   cv::buildOpticalFlowPyramid(flat_field(image.mat(), gain_map_), pyramid, window,
                               options_.pyramid_levels, true);
   return pyramid;
@@ -227,10 +226,11 @@ std::vector<cv::Mat> KltTracker::build_pyramid(const GrayImage& image) const {
 std::vector<PointMatch> KltTracker::track_existing(const GrayImage& image,
                                                    std::vector<int64_t>* ids, double stamp,
                                                    const ParallelFor& parallel) {
-  return track_pyramid(build_pyramid(image), ids, stamp, parallel);
+  return track_pyramid(build_pyramid(image), image, ids, stamp, parallel);
 }
 
 std::vector<PointMatch> KltTracker::track_pyramid(std::vector<cv::Mat> pyramid,
+                                                  const GrayImage& image,
                                                   std::vector<int64_t>* ids, double stamp,
                                                   const ParallelFor& parallel) {
   std::vector<PointMatch> matches;
@@ -242,10 +242,8 @@ std::vector<PointMatch> KltTracker::track_pyramid(std::vector<cv::Mat> pyramid,
     vignetting_.reset();
     gain_map_.release();
   }
-  // The image as it came, for its brightness and the corners; the pyramid's level 0 without
-  // a correction.
-  cv::Mat raw = pending_raw_.size() == size ? pending_raw_ : pyramid[0];
-  pending_raw_.release();
+  // The image as it came, for its brightness and the corners.
+  const cv::Mat raw = image.mat().size() == size ? image.mat() : pyramid[0];
 
   if (!previous_.empty() && !points_.empty()) {
     const int n = static_cast<int>(points_.size());

@@ -3,13 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "median.h"
+
 namespace hybrid_vo {
 namespace {
-
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 Eigen::Vector2d median_motion(const std::vector<Eigen::Vector2d>& motions) {
   std::vector<double> x, y;
@@ -17,7 +14,7 @@ Eigen::Vector2d median_motion(const std::vector<Eigen::Vector2d>& motions) {
     x.push_back(m.x());
     y.push_back(m.y());
   }
-  return Eigen::Vector2d(median(x), median(y));
+  return Eigen::Vector2d(median_of(x), median_of(y));
 }
 
 }  // namespace
@@ -83,7 +80,7 @@ bool PointFlowField::predict(const LineSegment& s, double radius_px, int min_poi
   if (static_cast<int>(all.size()) < std::max(1, min_points)) return false;
   Eigen::Vector2d m1 = median_motion(all), m2 = m1;
   if (first.size() >= 2 && second.size() >= 2) {
-    const double t1 = median(first_at), t2 = median(second_at);
+    const double t1 = median_of(first_at), t2 = median_of(second_at);
     if (t2 - t1 > 0.2) {
       const Eigen::Vector2d a = median_motion(first), b = median_motion(second);
       m1 = a + (0.0 - t1) / (t2 - t1) * (b - a);
@@ -94,7 +91,7 @@ bool PointFlowField::predict(const LineSegment& s, double radius_px, int min_poi
   std::vector<double> deviations;
   for (size_t k = 0; k < across.size(); ++k)
     deviations.push_back(std::abs(across[k] - n.dot(m1 + where[k] * (m2 - m1))));
-  *spread_px = 1.4826 * median(deviations);
+  *spread_px = 1.4826 * median_of(deviations);
   *predicted = LineSegment(s.p1 + m1, s.p2 + m2);
   return true;
 }

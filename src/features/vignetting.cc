@@ -5,6 +5,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "median.h"
+
 namespace hybrid_vo {
 namespace {
 
@@ -26,16 +28,10 @@ double window_brightness(const cv::Mat& image, const cv::Point2f& p) {
   return mean < 16.0 || mean > 239.0 ? -1.0 : mean;
 }
 
-double median(std::vector<double> v) {
-  const auto mid = v.begin() + v.size() / 2;
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 }  // namespace
 
 void VignettingEstimator::reset() {
-  n11_ = n12_ = n22_ = r1_ = r2_ = samples_ = 0.0;
+  n11_ = n12_ = n22_ = r1_ = r2_ = 0.0;
   pairs_ = 0;
   a_ = b_ = 0.0;
   active_ = false;
@@ -70,10 +66,10 @@ void VignettingEstimator::add_pair(const cv::Mat& from_image, const cv::Mat& to_
   // specular highlights) are down-weighted by their distance from it (Huber, then cut at 5 sigma).
   std::vector<double> e(y.size());
   for (size_t i = 0; i < y.size(); ++i) e[i] = y[i] - a_ * x1[i] - b_ * x2[i];
-  const double offset = median(e);
+  const double offset = median_of(e);
   std::vector<double> dev(e.size());
   for (size_t i = 0; i < e.size(); ++i) dev[i] = std::abs(e[i] - offset);
-  const double sigma = std::max(0.005, 1.4826 * median(dev));
+  const double sigma = std::max(0.005, 1.4826 * median_of(dev));
   std::vector<double> w(y.size());
   double sw = 0, m1 = 0, m2 = 0, my = 0;
   for (size_t i = 0; i < y.size(); ++i) {
@@ -88,7 +84,7 @@ void VignettingEstimator::add_pair(const cv::Mat& from_image, const cv::Mat& to_
   m2 /= sw;
   my /= sw;
   const double f = options_.forgetting;
-  n11_ *= f, n12_ *= f, n22_ *= f, r1_ *= f, r2_ *= f, samples_ *= f;
+  n11_ *= f, n12_ *= f, n22_ *= f, r1_ *= f, r2_ *= f;
   for (size_t i = 0; i < y.size(); ++i) {
     // Centred within the pair: its exposure change, unknown, drops out.
     const double u = x1[i] - m1, v = x2[i] - m2, t = y[i] - my;
@@ -98,7 +94,6 @@ void VignettingEstimator::add_pair(const cv::Mat& from_image, const cv::Mat& to_
     r1_ += w[i] * u * t;
     r2_ += w[i] * v * t;
   }
-  samples_ += sw;
   ++pairs_;
 
   // A lens only darkens outwards: V non-increasing on [0, 1] (a <= 0, a + 2 b <= 0); else, or

@@ -107,7 +107,8 @@ void VisualOdometry::track_points(Frame& f) {
       if (all_finite(external.points[i])) f.points[external.point_ids[i]] = external.points[i];
   } else if (f.tracking) {
     // The searches on both threads, the second once it has detected the segments.
-    f.point_motion = klt_.track_pyramid(f.pyramid, nullptr, f.input.stamp, worker_->parallel());
+    f.point_motion = klt_.track_pyramid(f.pyramid, f.gray, nullptr, f.input.stamp,
+                                        worker_->parallel());
     f.result.vignetting_corner_gain = klt_.vignetting().corner_gain();
     f.points = klt_points();
     if (f.klt_pyramid) f.pair.left = klt_.pyramid();

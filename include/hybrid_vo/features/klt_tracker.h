@@ -164,9 +164,10 @@ class KltTracker {
                                          double stamp = kNoStamp,
                                          const ParallelFor& parallel = {});
   // track_existing on the pyramid of the image (build_pyramid), built by the caller so that it
-  // serves the frame's other stages too (segments, stereo): one pyramid per frame.
+  // serves the frame's other stages too (segments, stereo): one pyramid per frame. `image` is the
+  // one the pyramid was built from, as it came (the pyramid's may have its vignetting taken out).
   std::vector<cv::Mat> build_pyramid(const GrayImage& image) const;
-  std::vector<PointMatch> track_pyramid(std::vector<cv::Mat> pyramid,
+  std::vector<PointMatch> track_pyramid(std::vector<cv::Mat> pyramid, const GrayImage& image,
                                         std::vector<int64_t>* ids = nullptr,
                                         double stamp = kNoStamp, const ParallelFor& parallel = {});
   // Fills the buckets of the last tracked image that have too few features; appends to points().
@@ -220,10 +221,8 @@ class KltTracker {
   std::vector<int> cell_tracks_;
   cv::Size size_;
   std::vector<cv::Mat> previous_;  // image pyramid with derivatives, built once per frame
-  // The last frame's image as it came (its brightness, and the corners' detection), and the one
-  // build_pyramid was last given, which track_pyramid takes over.
+  // The last frame's image as it came (its brightness, and the corners' detection).
   cv::Mat previous_raw_;
-  mutable cv::Mat pending_raw_;
   VignettingEstimator vignetting_;
   cv::Mat gain_map_;         // flat_field_gain()
   double map_corner_ = 1.0;  // the corner gain gain_map_ was made for

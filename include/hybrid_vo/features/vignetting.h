@@ -46,7 +46,6 @@ class VignettingEstimator {
   double corner_gain() const;
   double a() const { return a_; }
   double b() const { return b_; }
-  int samples() const { return static_cast<int>(samples_); }
   int pairs() const { return pairs_; }
   double information() const { return n11_; }  // see min_information
   void reset();
@@ -54,7 +53,6 @@ class VignettingEstimator {
  private:
   VignettingOptions options_;
   double n11_ = 0, n12_ = 0, n22_ = 0, r1_ = 0, r2_ = 0;  // normal equations (a, b)
-  double samples_ = 0;  // with forgetting
   int pairs_ = 0;
   double a_ = 0, b_ = 0;
   bool active_ = false;
