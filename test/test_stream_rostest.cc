@@ -243,7 +243,20 @@ TEST(Faults, EachFaultIsCountedAndRecoveredFrom) {
     EXPECT_EQ(check_fault(f, t + 0.1, nullptr, duplicates), 1.0);
   }
 
-  // 6. The image size switches mid-stream (another camera_info too): 240x180 from here on.
+  // 6. An image lost on the way: its camera_info arrives alone. The synchroniser gives the frame
+  // up once the next one completes, and it is counted; the stream goes on without a restart.
+  {
+    const double incomplete = run.counter("incomplete frames dropped");
+    const double t = run.stamp() + 0.1;
+    h.left_info_.publish(info_of(make(320, 240, 1).camera, ros::Time(t), kFrame));
+    ++index;
+    h.spin_for(0.3);
+    Fault f{"image lost in transport", "incomplete frames dropped"};
+    f.restarts = false;
+    EXPECT_EQ(check_fault(f, t + 0.1, nullptr, incomplete), 1.0);
+  }
+
+  // 7. The image size switches mid-stream (another camera_info too): 240x180 from here on.
   EXPECT_EQ(check_fault({"image size switched", "image size changes (restarts)"},
                         run.stamp() + 0.1, &run.small()),
             1.0);

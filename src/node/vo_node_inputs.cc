@@ -64,6 +64,7 @@ void VoNode::synchronise(message_filters::Subscriber<ImageMsg>* left,
     auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(
         Policy(params_.queue_size), *left, left_info_sub_, *right, right_info_sub_);
     sync->registerCallback(&VoNode::stereo_callback<ImageMsg>, this);
+    sync->registerDropCallback(&VoNode::stereo_dropped<ImageMsg>, this);
     sync_ = sync;
   } else if (params_.approximate_sync) {
     using Policy = policies::ApproximateTime<ImageMsg, Info>;
@@ -76,8 +77,25 @@ void VoNode::synchronise(message_filters::Subscriber<ImageMsg>* left,
     auto sync = std::make_shared<message_filters::Synchronizer<Policy>>(Policy(params_.queue_size),
                                                                         *left, left_info_sub_);
     sync->registerCallback(&VoNode::mono_callback<ImageMsg>, this);
+    sync->registerDropCallback(&VoNode::mono_dropped<ImageMsg>, this);
     sync_ = sync;
   }
+}
+
+template <class ImageMsg>
+void VoNode::mono_dropped(const boost::shared_ptr<const ImageMsg>&,
+                          const sensor_msgs::CameraInfoConstPtr&) {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++dropped_;
+}
+
+template <class ImageMsg>
+void VoNode::stereo_dropped(const boost::shared_ptr<const ImageMsg>&,
+                            const sensor_msgs::CameraInfoConstPtr&,
+                            const boost::shared_ptr<const ImageMsg>&,
+                            const sensor_msgs::CameraInfoConstPtr&) {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++dropped_;
 }
 
 template <class ImageMsg>

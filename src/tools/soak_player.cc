@@ -222,8 +222,10 @@ class Player {
   int run() {
     ros::NodeHandle nh;
     const std::string prefix = "/camera/" + o_.camera;
-    image_pub_ = nh.advertise<sensor_msgs::Image>(prefix + "/image_raw", 5);
-    info_pub_ = nh.advertise<sensor_msgs::CameraInfo>(prefix + "/camera_info", 5);
+    // rosbag play's outgoing queue (100): a short stall of the node's receiving thread under
+    // overload must not lose frames in the player, where the node cannot count them.
+    image_pub_ = nh.advertise<sensor_msgs::Image>(prefix + "/image_raw", 100);
+    info_pub_ = nh.advertise<sensor_msgs::CameraInfo>(prefix + "/camera_info", 100);
     static_pub_ = nh.advertise<tf2_msgs::TFMessage>("/tf_static", 1, true);
     motion_sub_ = nh.subscribe("/" + o_.node + "/relative_pose", 1000, &Player::on_motion, this,
                                ros::TransportHints().tcpNoDelay());
@@ -369,8 +371,10 @@ class Player {
     for (const auto& s : d->status) {
       if (s.name.find("odometry") == std::string::npos) continue;
       std::lock_guard<std::mutex> lock(mutex_);
-      for (const auto& kv : s.values)
+      for (const auto& kv : s.values) {
         if (kv.key == "frames dropped (queue full)") queue_drops_ = std::atoi(kv.value.c_str());
+        if (kv.key == "incomplete frames dropped") incomplete_drops_ = std::atoi(kv.value.c_str());
+      }
     }
   }
 
@@ -406,11 +410,11 @@ class Player {
     std::printf(
         "summary: frames=%d dropped=%d rss_start_mb=%.1f rss_end_mb=%.1f "
         "rss_slope_mb_per_h=%.2f latency_p50_ms=%.1f latency_p99_ms=%.1f rate_hz=%.2f "
-        "cpu_percent=%.1f ok=%d queue_drops=%d duration_s=%.0f warmup_s=%.0f "
+        "cpu_percent=%.1f ok=%d queue_drops=%d incomplete_drops=%d duration_s=%.0f warmup_s=%.0f "
         "steady_from_s=%.0f load1=%.1f %s\n",
         sent_, sent_ - answered, rss.empty() ? 0.0 : rss.front(), rss.empty() ? 0.0 : rss.back(),
         slope(t, rss), quantile(latencies, 0.5), p99,
-        duration > 0 ? answered / duration : 0.0, cpu_mean, ok_, queue_drops_, duration, warmup_s_,
+        duration > 0 ? answered / duration : 0.0, cpu_mean, ok_, queue_drops_, incomplete_drops_, duration, warmup_s_,
         std::isfinite(steady_from) ? steady_from : -1.0, load_mean, rate_field.c_str());
     std::fflush(stdout);
   }
@@ -430,7 +434,7 @@ class Player {
   std::map<ros::Time, Clock::time_point> sent_at_;
   std::map<ros::Time, double> answers_;  // stamp -> latency (ms)
   std::vector<double> window_latencies_, steady_latencies_;
-  int sent_ = 0, ok_ = 0, queue_drops_ = 0;
+  int sent_ = 0, ok_ = 0, queue_drops_ = 0, incomplete_drops_ = 0;
   std::vector<double> samples_t_, samples_rss_, samples_cpu_, samples_load_;
 };
 

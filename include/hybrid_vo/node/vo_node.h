@@ -111,6 +111,13 @@ class VoNode {
                        const sensor_msgs::CameraInfoConstPtr& left_info,
                        const boost::shared_ptr<const ImageMsg>& right,
                        const sensor_msgs::CameraInfoConstPtr& right_info);
+  // A frame whose parts never all arrived (an image or a camera_info lost in transport): the
+  // exact synchroniser gives it up once a later frame completes, and it is counted.
+  template <class ImageMsg>
+  void mono_dropped(const boost::shared_ptr<const ImageMsg>&, const sensor_msgs::CameraInfoConstPtr&);
+  template <class ImageMsg>
+  void stereo_dropped(const boost::shared_ptr<const ImageMsg>&, const sensor_msgs::CameraInfoConstPtr&,
+                      const boost::shared_ptr<const ImageMsg>&, const sensor_msgs::CameraInfoConstPtr&);
   // Every image of the (left) topic, synchronised or not: tells "no images" from "images
   // without camera_info".
   template <class ImageMsg>
