@@ -93,6 +93,61 @@ HalvesError halves_error(const PinholeCamera& camera, const TwoViewMatches& m,
   return e;
 }
 
+// The point inliers split two ways, each half refined alone from the estimator's pose with its
+// own curvature covariance: how far the halves' rotations lie apart under their claimed
+// covariances (NEES, 3 dof: 2.37 median if the points' errors were independent), split by image
+// row (top / bottom: what a rolling shutter or a region's shading would move) and interleaved
+// (every other track); and the points' own rotation against the truth under their curvature.
+// Their ratio to 2.37 is how many times the points' independence overstates what they know.
+struct SplitNees {
+  double rows = NAN, interleaved = NAN, truth = NAN;
+};
+
+SplitNees split_nees(const PinholeCamera& camera, const TwoViewMatches& m,
+                     const RelativePoseEstimate& est, const RelativePose& truth) {
+  std::vector<PointMatch> points;
+  for (size_t k = 0; k < m.points.size() && k < est.point_inliers.size(); ++k)
+    if (est.point_inliers[k]) points.push_back(m.points[k]);
+  SplitNees out;
+  if (points.size() < 20 || !(est.scales.point_px > 0.0)) return out;
+  FinalRefinementOptions o;
+  o.compute_covariance = true;
+  o.point_sigma_px = est.scales.point_px;
+  struct Fit {
+    bool ok = false;
+    Eigen::Matrix3d R, C;
+  };
+  const auto fit = [&](const std::vector<PointMatch>& p) {
+    Fit f;
+    const FinalRefinementResult r = refine_relative_pose_ceres(camera, camera, p, {}, {}, {}, est.pose, o);
+    if (!r.success || !r.covariance_valid) return f;
+    f.ok = true;
+    f.R = r.pose.R;
+    f.C = r.covariance.topLeftCorner<3, 3>();
+    return f;
+  };
+  const auto nees = [](const Eigen::Matrix3d& Ra, const Eigen::Matrix3d& Rb, const Eigen::Matrix3d& C) {
+    const Eigen::AngleAxisd apart(Eigen::Matrix3d(Ra * Rb.transpose()));
+    const Eigen::Vector3d w = apart.angle() * apart.axis();
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(C);
+    return ldlt.info() == Eigen::Success && ldlt.isPositive() ? w.dot(ldlt.solve(w)) : NAN;
+  };
+  std::vector<PointMatch> sorted = points;
+  std::sort(sorted.begin(), sorted.end(),
+            [](const PointMatch& a, const PointMatch& b) { return a.x2.y() < b.x2.y(); });
+  const size_t half = sorted.size() / 2;
+  const Fit top = fit({sorted.begin(), sorted.begin() + half});
+  const Fit bottom = fit({sorted.begin() + half, sorted.end()});
+  if (top.ok && bottom.ok) out.rows = nees(top.R, bottom.R, top.C + bottom.C);
+  std::vector<PointMatch> even, odd;
+  for (size_t k = 0; k < points.size(); ++k) (k % 2 ? odd : even).push_back(points[k]);
+  const Fit a = fit(even), b = fit(odd);
+  if (a.ok && b.ok) out.interleaved = nees(a.R, b.R, a.C + b.C);
+  const Fit all = fit(points);
+  if (all.ok) out.truth = nees(all.R, truth.R, all.C);
+  return out;
+}
+
 void usage(const char* program) {
   std::cerr << "Usage: " << program
             << " SEQUENCE_DIR [--config FILE [--param NAME=VALUE]...] [--frames N] [--preset P]"
@@ -718,6 +773,9 @@ int run(int argc, char** argv) {
           std::printf("   each half alone from the estimator's pose, rotation off the truth (deg): "
                       "KLT points %.3f, junctions %.3f, junctions with segments and VPs %.3f\n",
                       halves.points, halves.junctions, halves.rest);
+          const SplitNees split = split_nees(cam, r.matches, est, truth_pose);
+          std::printf("   split NEES (3 dof, points): rows %.2f, interleaved %.2f, full against the truth %.2f\n",
+                      split.rows, split.interleaved, split.truth);
         }
       }
     }
