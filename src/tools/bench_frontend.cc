@@ -479,6 +479,10 @@ int run(int argc, char** argv) {
       o.rotation_only_pairs = false;
     else if (a == "--independent-translation-points" && i + 1 < argc)
       o.estimator.covariance.independent_translation_points = std::atof(argv[++i]);
+    else if (a == "--ambiguity-independent-points" && i + 1 < argc)
+      o.estimator.covariance.ambiguity_independent_points = std::atof(argv[++i]);
+    else if (a == "--independent-points" && i + 1 < argc)
+      o.estimator.covariance.independent_points = std::atof(argv[++i]);
     else if ((a == "--keyframe-overlap" || a == "--rotation-keyframe-overlap") && i + 1 < argc)
       o.keyframe_overlap = std::atof(argv[++i]);
     else if (a == "--stereo-translation-margin" && i + 1 < argc)
@@ -769,6 +773,23 @@ int run(int argc, char** argv) {
                       "points %.3f / %.3f (%zu), junctions %.3f / %.3f (%zu)%s\n",
                       median(pe), median(pt), pe.size(), median(je), median(jt), je.size(),
                       est.refined ? "" : "; not refined (the refinement lost inliers)");
+          {
+            // The estimator's own direction sigma (degrees), reported and from the curvature alone.
+            const Eigen::Vector3d u = est.pose.t.normalized();
+            const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - u * u.transpose();
+            auto dir_sigma = [&](const Eigen::Matrix<double, 6, 6>& C) {
+              return std::sqrt(0.5 * (across * C.bottomRightCorner<3, 3>() * across).trace()) /
+                     std::max(1e-12, est.pose.t.norm()) * 180.0 / M_PI;
+            };
+            std::printf("   estimator: direction error %.3f deg, sigma %.3f deg (curvature %.3f), rotation "
+                        "error %.4f deg, sigma %.4f deg (curvature %.4f); %d point + %d junction inliers\n",
+                        translation_error(est.pose.t, truth_pose.t) * 180.0 / M_PI,
+                        dir_sigma(est.covariance), dir_sigma(est.hessian_covariance),
+                        rotation_error(est.pose.R, truth_pose.R) * 180.0 / M_PI,
+                        std::sqrt(est.covariance.topLeftCorner<3, 3>().trace() / 3) * 180 / M_PI,
+                        std::sqrt(est.hessian_covariance.topLeftCorner<3, 3>().trace() / 3) * 180 / M_PI,
+                        est.num_point_inliers, est.num_junction_inliers);
+          }
           const HalvesError halves = halves_error(cam, r.matches, est, truth_pose);
           std::printf("   each half alone from the estimator's pose, rotation off the truth (deg): "
                       "KLT points %.3f, junctions %.3f, junctions with segments and VPs %.3f\n",
