@@ -4,6 +4,7 @@
 #include "line_geometric_filter.h"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include <Eigen/Cholesky>
@@ -43,11 +44,13 @@ double dominant_angle(const std::vector<double>& angles) {
 }
 
 // Distance between two segments: 0 when they cross, else the smallest endpoint-to-segment one.
-double point_segment_distance(const Eigen::Vector2d& p, const LineSegment& s) {
+// Squared until the end: one square root instead of four (the same value: a square root is
+// monotonic and correctly rounded).
+double point_segment_squared_distance(const Eigen::Vector2d& p, const LineSegment& s) {
   const Eigen::Vector2d d = s.p2 - s.p1;
   const double l2 = d.squaredNorm();
   const double t = l2 > 0.0 ? std::min(1.0, std::max(0.0, (p - s.p1).dot(d) / l2)) : 0.0;
-  return (s.p1 + t * d - p).norm();
+  return (s.p1 + t * d - p).squaredNorm();
 }
 
 double segment_distance(const LineSegment& s, const LineSegment& t) {
@@ -58,8 +61,9 @@ double segment_distance(const LineSegment& s, const LineSegment& t) {
   const double c1 = cross(ds, t.p1 - s.p1), c2 = cross(ds, t.p2 - s.p1);
   const double c3 = cross(dt, s.p1 - t.p1), c4 = cross(dt, s.p2 - t.p1);
   if (c1 * c2 < 0.0 && c3 * c4 < 0.0) return 0.0;
-  return std::min(std::min(point_segment_distance(t.p1, s), point_segment_distance(t.p2, s)),
-                  std::min(point_segment_distance(s.p1, t), point_segment_distance(s.p2, t)));
+  return std::sqrt(std::min(
+      std::min(point_segment_squared_distance(t.p1, s), point_segment_squared_distance(t.p2, s)),
+      std::min(point_segment_squared_distance(s.p1, t), point_segment_squared_distance(s.p2, t))));
 }
 
 // Side of segment `t` relative to the oriented line `l` (line_through of a segment): +1 or -1
@@ -221,9 +225,9 @@ class LocalConsensus {
 
   // Among `voters`, the k nearest to a segment (its `distances`), skipping the query.
   std::vector<int> nearest(const std::vector<double>& d, const std::vector<int>& voters, int k,
-                           size_t query) const {
-    std::vector<std::pair<double, int>> order;
-    order.reserve(voters.size());
+                           size_t query) {
+    std::vector<std::pair<double, int>>& order = order_;  // scratch, kept between calls
+    order.clear();
     for (int v : voters)
       if (static_cast<size_t>(pool_[v]) != query) order.emplace_back(d[v], v);
     const size_t count = std::min(order.size(), static_cast<size_t>(std::max(k, 0)));
@@ -242,6 +246,7 @@ class LocalConsensus {
   std::vector<int> pool_;
   std::vector<std::vector<double>> to1_, to2_;
   std::vector<char> in_near2_;  // scratch: the second image's nearest voters of a query
+  std::vector<std::pair<double, int>> order_;  // scratch: voters by distance
 };
 
 }  // namespace
