@@ -82,11 +82,15 @@ void VoNode::synchronise(message_filters::Subscriber<ImageMsg>* left,
   }
 }
 
+void VoNode::count_incomplete(int frames) {
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  dropped_ += frames;
+}
+
 template <class ImageMsg>
 void VoNode::mono_dropped(const boost::shared_ptr<const ImageMsg>&,
                           const sensor_msgs::CameraInfoConstPtr&) {
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  ++dropped_;
+  count_incomplete(1);
 }
 
 template <class ImageMsg>
@@ -94,8 +98,7 @@ void VoNode::stereo_dropped(const boost::shared_ptr<const ImageMsg>&,
                             const sensor_msgs::CameraInfoConstPtr&,
                             const boost::shared_ptr<const ImageMsg>&,
                             const sensor_msgs::CameraInfoConstPtr&) {
-  std::lock_guard<std::mutex> lock(stats_mutex_);
-  ++dropped_;
+  count_incomplete(1);
 }
 
 template <class ImageMsg>
@@ -111,8 +114,7 @@ VoNode::Frame& VoNode::pending(const ros::Time& stamp) {
   // A bounded wait: features or images that never complete a frame are dropped, oldest first.
   while (pending_.size() > 50) {
     pending_.erase(pending_.begin());
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    ++dropped_;
+    count_incomplete(1);
   }
   return pending_[stamp];
 }
@@ -188,10 +190,7 @@ void VoNode::try_process(const ros::Time& stamp) {
     if (p->first < stamp) ++incomplete;
     p = pending_.erase(p);
   }
-  if (incomplete > 0) {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    dropped_ += incomplete;
-  }
+  if (incomplete > 0) count_incomplete(incomplete);
   queue_->push(std::move(frame));
 }
 

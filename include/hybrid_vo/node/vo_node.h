@@ -118,6 +118,8 @@ class VoNode {
   template <class ImageMsg>
   void stereo_dropped(const boost::shared_ptr<const ImageMsg>&, const sensor_msgs::CameraInfoConstPtr&,
                       const boost::shared_ptr<const ImageMsg>&, const sensor_msgs::CameraInfoConstPtr&);
+  // Frames that can no longer be completed, into "incomplete frames dropped".
+  void count_incomplete(int frames);
   // Every image of the (left) topic, synchronised or not: tells "no images" from "images
   // without camera_info".
   template <class ImageMsg>
