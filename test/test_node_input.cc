@@ -92,6 +92,63 @@ TEST(FrameQueue, SlowConsumerSeesFramesInOrderAndEveryLossIsCounted) {
   }
 }
 
+// The spare slots open only while the consumer keeps up: a fake clock drives arrivals 33 ms
+// apart and a consumer taking `service` seconds a frame.
+TEST(FrameQueue, SpareSlotsHoldFramesBehindOneSlowFrameButNotUnderOverload) {
+  double now = 0.0;
+  FrameQueue<int> q(1, 2, [&] { return now; });
+  EXPECT_EQ(q.spare(), 2u);
+  int v = 0;
+  // Nothing measured yet: a first frame's set-up is no overload.
+  EXPECT_TRUE(q.keeping_up());
+  // Twenty frames at 30 Hz, each taken at once and served in 20 ms.
+  for (int i = 0; i < 20; ++i) {
+    EXPECT_EQ(q.push(i), 0);
+    ASSERT_TRUE(q.pop(&v));
+    EXPECT_EQ(v, i);
+    now += 0.020;
+    q.finished();
+    now += 0.013;  // the next arrival
+  }
+  EXPECT_TRUE(q.keeping_up());
+  // One frame takes 100 ms: three arrive meanwhile and all wait.
+  q.push(20);
+  ASSERT_TRUE(q.pop(&v));
+  for (int i = 21; i <= 23; ++i) {
+    now += 0.033;
+    EXPECT_EQ(q.push(i), 0) << "frame " << i;
+  }
+  now += 0.001;
+  q.finished();
+  EXPECT_EQ(q.size(), 3u);
+  for (int i = 21; i <= 23; ++i) {
+    ASSERT_TRUE(q.pop(&v));
+    EXPECT_EQ(v, i);
+    now += 0.005;  // the backlog served quickly
+    q.finished();
+  }
+  EXPECT_TRUE(q.keeping_up()) << "one slow frame is no overload";
+  EXPECT_EQ(q.dropped(), 0u);
+
+  // Overload: every frame takes 66 ms, two periods. Within five frames the spare slots close and
+  // at most one frame waits, the oldest dropped.
+  q.push(199);
+  for (int i = 100; i < 130; ++i) {
+    ASSERT_TRUE(q.pop(&v));
+    now += 0.033;
+    q.push(2 * i);
+    now += 0.033;
+    q.push(2 * i + 1);
+    q.finished();  // 66 ms since the pop
+    if (i >= 110) {
+      EXPECT_FALSE(q.keeping_up());
+      EXPECT_LE(q.size(), 1u);
+    }
+  }
+  EXPECT_GT(q.dropped(), 15u);
+  EXPECT_EQ(FrameQueue<int>(1).spare(), 0u);
+}
+
 TEST(StreamMonitor, ClassifiesEachFault) {
   StreamMonitorOptions options;
   options.max_gap_s = 1.0;

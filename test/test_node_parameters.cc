@@ -67,6 +67,7 @@ std::vector<Case> every_parameter() {
       {"queue_size", 3, [](P p) { return p.queue_size == 3; }},
       {"camera_info_timeout", 5.0, [](P p) { return p.camera_info_timeout == 5.0; }},
       {"frame_queue_size", 4, [](P p) { return p.frame_queue_size == 4; }},
+      {"frame_queue_spare", 0, [](P p) { return p.frame_queue_spare == 0; }},
       {"max_frame_gap", 2.5, [](P p) { return p.stream.max_gap_s == 2.5; }},
       {"feature_points", true, [](P p) { return p.feature_points; }},
       {"feature_lines", true, [](P p) { return p.feature_lines; }},
@@ -190,6 +191,7 @@ TEST(NodeParameters, BadValuesAndUnknownNamesAreReportedAndKeepTheDefault) {
       {"klt_window_px", 3, "must be in [5, 401]"},
       {"klt_window_px", 402, "must be in [5, 401]"},
       {"frame_queue_size", 0, "must be >= 1"},
+      {"frame_queue_spare", -1, "must be >= 0"},
       {"rectified_fov_deg", 5.0, "must be in [10, 170]"},
       {"max_frame_gap", 0.0, "must be > 0"},
       {"point_threshold_px", -1.0, "must be > 0"},
@@ -208,6 +210,7 @@ TEST(NodeParameters, BadValuesAndUnknownNamesAreReportedAndKeepTheDefault) {
     EXPECT_EQ(p.odometry.estimator.vp_detection.min_inliers, 6);
     EXPECT_EQ(p.odometry.klt.window_px, defaults.odometry.klt.window_px);
     EXPECT_EQ(p.frame_queue_size, 1);
+    EXPECT_EQ(p.frame_queue_spare, 2);
     EXPECT_EQ(p.rectified_fov_deg, 100.0);
     EXPECT_FALSE(p.stereo || p.compressed);
     EXPECT_EQ(p.preset, "hybrid");

@@ -103,6 +103,7 @@ const std::vector<Parameter>& parameters() {
       field<int>("queue_size", NODE_FIELD(int, queue_size)),
       field<double>("camera_info_timeout", NODE_FIELD(double, camera_info_timeout)),
       field<int>("frame_queue_size", NODE_FIELD(int, frame_queue_size)),
+      field<int>("frame_queue_spare", NODE_FIELD(int, frame_queue_spare)),
       field<double>("max_frame_gap", NODE_FIELD(double, stream.max_gap_s)),
       field<bool>("feature_points", NODE_FIELD(bool, feature_points)),
       field<bool>("feature_lines", NODE_FIELD(bool, feature_lines)),

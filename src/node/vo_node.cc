@@ -45,7 +45,8 @@ VoNode::VoNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
     : nh_(nh), pnh_(private_nh), tf_listener_(tf_buffer_), updater_(nh, private_nh) {
   load_parameters();
   vo_ = std::make_unique<VisualOdometry>(params_.odometry);
-  queue_ = std::make_unique<FrameQueue<Frame>>(params_.frame_queue_size);
+  queue_ = std::make_unique<FrameQueue<Frame>>(params_.frame_queue_size,
+                                               params_.frame_queue_spare);
 
   relative_pose_pub_ = pnh_.advertise<MotionEstimate>("relative_pose", 10);
   odometry_pub_ = pnh_.advertise<nav_msgs::Odometry>("odometry", 10);
@@ -101,6 +102,7 @@ void VoNode::run() {
       std::lock_guard<std::mutex> lock(process_mutex_);
       process(frame);
     }
+    queue_->finished();
     frame = Frame();  // the images are not kept while waiting
   }
 }

@@ -29,6 +29,9 @@ struct NodeParameters {
   bool publish_debug_image = true, publish_markers = true;
   double min_frequency = 1.0, max_frequency = 100.0;
   int frame_queue_size = 1;
+  // Frames that may wait beyond frame_queue_size while the node keeps up (FrameQueue): a slow
+  // frame delays the next ones instead of losing them.
+  int frame_queue_spare = 2;
   int path_max_poses = 5000;
   // OpenCV's own thread pool for the process (cv::setNumThreads); < 0 leaves OpenCV's default.
   // 1: none, since the front end splits its work over its two threads itself (doc/performance.md).
@@ -47,6 +50,7 @@ void visit_fields(NodeParameters& p, Visit&& visit) {
   visit("min_frequency", p.min_frequency, non_negative());
   visit("max_frequency", p.max_frequency, positive());
   visit("frame_queue_size", p.frame_queue_size, at_least(1));
+  visit("frame_queue_spare", p.frame_queue_spare, non_negative());
   visit("path_max_poses", p.path_max_poses, non_negative());
   visit("max_frame_gap", p.stream.max_gap_s, positive());
   visit_fields(p.odometry, visit);
