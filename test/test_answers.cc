@@ -139,6 +139,35 @@ TEST(Answers, TurningInPlaceWithALeverArm) {
   for (int i = 1; i < frames; ++i) EXPECT_LT(orientation_error_deg(mono, i), 1.0) << i;
 }
 
+// A camera turning at 30 deg/s with keyframe_max_turn_deg: no frame is answered against a
+// keyframe it has turned further from than the limit and one frame's turn, every frame is
+// answered, and the orientation holds; without the limit the keyframe stays over more.
+TEST(Answers, AKeyframeTurnedTooFarIsReplaced) {
+  const double rate = 30.0, limit = 5.0;
+  VisualOdometryOptions limited = sequential();
+  limited.keyframe_max_turn_deg = limit;
+  const OdometryRun run = run_rendered(Motion::kTurn, 60, rate, false, 2, limited);
+  const OdometryRun free = run_rendered(Motion::kTurn, 60, rate, false, 2);
+  auto widest = [&](const OdometryRun& r) {
+    double most = 0.0;
+    for (size_t i = 1; i < r.results.size(); ++i) {
+      const int ref = static_cast<int>(std::lround((r.results[i].reference_stamp - 1.0) * rate));
+      if (ref < 0 || ref >= static_cast<int>(i)) continue;
+      const Eigen::AngleAxisd turn(r.R_true[i].transpose() * r.R_true[ref]);
+      most = std::max(most, turn.angle() * kDeg);
+    }
+    return most;
+  };
+  const int frames = static_cast<int>(run.results.size());
+  EXPECT_EQ(answered_frames(run), frames - 1);
+  for (int i = 1; i < frames; ++i) EXPECT_LT(orientation_error_deg(run, i), 1.0) << i;
+  const double per_frame = 30.0 / rate;
+  EXPECT_LE(widest(run), limit + per_frame + 0.1);
+  EXPECT_GT(widest(free), limit + per_frame + 0.1);
+  RecordProperty("widest_link_deg", std::to_string(widest(run)) + " (" +
+                                        std::to_string(widest(free)) + " without the limit)");
+}
+
 // Still for a second, then walking: the stereo position stays within a centimetre while the
 // camera stands, and has the walk's length at the end.
 TEST(Answers, StartingFromRest) {

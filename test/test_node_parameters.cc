@@ -83,6 +83,7 @@ std::vector<Case> every_parameter() {
       {"min_parallax_px", 3.5, [](P p) { return p.odometry.min_parallax_px == 3.5; }},
       {"rotation_only_pairs", false, [](P p) { return !p.odometry.rotation_only_pairs; }},
       {"keyframe_overlap", 0.5, [](P p) { return p.odometry.keyframe_overlap == 0.5; }},
+      {"keyframe_max_turn_deg", 15.0, [](P p) { return p.odometry.keyframe_max_turn_deg == 15.0; }},
       {"keyframe_parallax_px", 9.0, [](P p) { return p.odometry.keyframe_parallax_px == 9.0; }},
       {"keyframe_min_points", 50, [](P p) { return p.odometry.keyframe_min_points == 50; }},
       {"previous_keyframe_parallax_px", 4.5,

@@ -133,6 +133,7 @@ const std::vector<Parameter>& parameters() {
       field<double>("previous_keyframe_parallax_px",
                     NODE_FIELD(double, odometry.previous_keyframe_parallax_px)),
       field<double>("keyframe_overlap", NODE_FIELD(double, odometry.keyframe_overlap)),
+      field<double>("keyframe_max_turn_deg", NODE_FIELD(double, odometry.keyframe_max_turn_deg)),
       field<int>("keyframe_min_points", NODE_FIELD(int, odometry.keyframe_min_points)),
       field<bool>("track_lines", NODE_FIELD(bool, odometry.track_lines)),
       field<bool>("line_flow", NODE_FIELD(bool, odometry.line_flow)),

@@ -1,14 +1,18 @@
 // VisualOdometry's keyframe policy: every frame is paired with the last keyframe. A frame becomes
 // the keyframe when its parallax after the rotation reaches keyframe_parallax_px (a baseline
 // that fixes the translation), when the keyframe's points are leaving the view (keyframe_overlap,
-// keyframe_min_points), and when a new chain starts at it (the first frame, or too few matches to
+// keyframe_min_points), when it has turned keyframe_max_turn_deg from it, and when a new chain
+// starts at it (the first frame, or too few matches to
 // pair it). Until then the keyframe stays, so that the baseline grows: frames with some parallax
 // are answered with their full pose against it, those that moved too little off their rotation
 // for a baseline (min_parallax_px), or whose points' noise explains what the rotation leaves
 // (model selection), with their rotation alone; in mono, those with the keyframe before where it
 // gives them a baseline (previous_keyframe_parallax_px). Without rotation-only pairs such frames
 // are left out, as any frame whose pose is not found. Also what a keyframe keeps.
+#include <cmath>
 #include <string>
+
+#include <Eigen/Geometry>
 
 #include "vo_frame.h"
 
@@ -48,6 +52,9 @@ bool VisualOdometry::keeps_keyframe(const Frame& f) const {
   const bool short_baseline = f.rotation_only || !f.baseline ||
                               (f.parallax >= 0.0 && f.parallax < options_.keyframe_parallax_px);
   const int seen = f.result.num_point_matches;
+  const double turned_deg = Eigen::AngleAxisd(f.result.motion.R).angle() * 180.0 / M_PI;
+  if (options_.keyframe_max_turn_deg > 0.0 && turned_deg > options_.keyframe_max_turn_deg)
+    return false;
   return short_baseline && seen >= options_.keyframe_min_points &&
          seen >= options_.keyframe_overlap * std::max(0, keyframe_.paired_points);
 }

@@ -221,7 +221,8 @@ void usage(const char* program) {
                "  --no-rotation-only: frames without a baseline are skipped, not answered\n"
                "  (rotation_only_pairs: false); --rotation-keyframe-overlap F: the node's\n"
                "  keyframe_overlap; --keyframe-parallax P: keyframe_parallax_px (0: every frame\n"
-               "  with a baseline becomes the keyframe). --mono-window K: mono_window_keyframes (a new\n"
+               "  with a baseline becomes the keyframe); --keyframe-max-turn D: keyframe_max_turn_deg.\n"
+               "  --mono-window K: mono_window_keyframes (a new\n"
                "  keyframe link's length fitted with the last links over K keyframes; < 3: off).\n"
                "  --stereo-translation-margin M: a stereo pair takes\n"
                "  the stereo points' translation where its covariance is M times smaller (0:\n"
@@ -434,6 +435,8 @@ int run(int argc, char** argv) {
     else if (a == "--mono-window" && i + 1 < argc)
       o.mono_window_keyframes = std::atoi(argv[++i]);
     else if (a == "--min-parallax" && i + 1 < argc) o.min_parallax_px = std::atof(argv[++i]);
+    else if (a == "--keyframe-max-turn" && i + 1 < argc)
+      o.keyframe_max_turn_deg = std::atof(argv[++i]);
     else if (a == "--verbose") verbose = true;
     else if (a == "--trajectory" && i + 1 < argc) trajectory_path = argv[++i];
     else if (a == "--direct-gap" && i + 1 < argc) {
