@@ -21,7 +21,7 @@ namespace hybrid_vo {
 // `spare` more frames may wait while the consumer keeps up (the median of its last nine times per
 // frame below the mean time between the last nine arrivals): one slow frame then
 // delays the next ones instead of losing them, as a replayed bag or a robot's camera expects
-// (a 30 Hz hand-held camera lost one frame of 458 to a single slow keyframe). Under overload the
+// (a keyframe or the first frame may take a few periods). Under overload the
 // consumer does not keep up, the spare slots close and the delay stays bounded by `capacity`.
 template <typename T>
 class FrameQueue {
