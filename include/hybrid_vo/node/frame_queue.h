@@ -65,7 +65,7 @@ class FrameQueue {
   }
 
   // The consumer is done with the frame it popped last: its time since pop() tells whether it
-  // keeps up. A consumer that never says so gets no spare slot.
+  // keeps up. Until it has said so once, it is taken to keep up (keeps_up()).
   void finished() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (last_pop_ >= 0.0) service_time_.add(clock_() - last_pop_);
